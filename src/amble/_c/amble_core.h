@@ -1,0 +1,111 @@
+/* Helpers shared by generated model code: small dense linear solves.
+ *
+ * Generated kernels call these from the right-hand side (mass matrix solve) and from impulsive
+ * resets (the KKT system of a plastic impact); sizes are a few dozen at most, so plain
+ * Cholesky / partial-pivoting LU on the stack is the fastest choice.
+ */
+#ifndef AMBLE_CORE_H
+#define AMBLE_CORE_H
+#include <math.h>
+#include <string.h>
+
+/* Error codes returned by kernels (0 = ok). */
+#define AMBLE_ERR_SINGULAR_MASS 1
+#define AMBLE_ERR_SINGULAR_RESET 2
+
+/* Solve A x = b for symmetric positive definite A (row-major n x n, only the lower triangle is
+ * read; A is overwritten by its Cholesky factor, b by x). Returns AMBLE_ERR_SINGULAR_MASS if a
+ * pivot is not positive or the factor's condition estimate exceeds 1e14. */
+static int amble_chol_solve(int n, double *A, double *b) {
+    double dmin = INFINITY, dmax = 0.0;
+    for (int j = 0; j < n; ++j) {
+        double s = A[j * n + j];
+        for (int k = 0; k < j; ++k) s -= A[j * n + k] * A[j * n + k];
+        if (!(s > 0.0)) return AMBLE_ERR_SINGULAR_MASS;
+        double d = sqrt(s);
+        A[j * n + j] = d;
+        if (d < dmin) dmin = d;
+        if (d > dmax) dmax = d;
+        for (int i = j + 1; i < n; ++i) {
+            double v = A[i * n + j];
+            for (int k = 0; k < j; ++k) v -= A[i * n + k] * A[j * n + k];
+            A[i * n + j] = v / d;
+        }
+    }
+    /* cond(A) >= (dmax/dmin)^2; beyond ~1e14 the solve has no correct digits left. */
+    if (dmax > 1e7 * dmin) return AMBLE_ERR_SINGULAR_MASS;
+    for (int i = 0; i < n; ++i) {
+        double v = b[i];
+        for (int k = 0; k < i; ++k) v -= A[i * n + k] * b[k];
+        b[i] = v / A[i * n + i];
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double v = b[i];
+        for (int k = i + 1; k < n; ++k) v -= A[k * n + i] * b[k];
+        b[i] = v / A[i * n + i];
+    }
+    return 0;
+}
+
+/* Solve A x = b for a general square A (row-major n x n) by LU with partial pivoting.
+ * A and b are overwritten (b by x). Returns AMBLE_ERR_SINGULAR_RESET on a (near) zero pivot. */
+static int amble_lu_solve(int n, double *A, double *b) {
+    double scale = 0.0;
+    for (int i = 0; i < n * n; ++i) scale = fmax(scale, fabs(A[i]));
+    if (!(scale > 0.0)) return AMBLE_ERR_SINGULAR_RESET;
+    for (int k = 0; k < n; ++k) {
+        int piv = k;
+        double best = fabs(A[k * n + k]);
+        for (int i = k + 1; i < n; ++i)
+            if (fabs(A[i * n + k]) > best) { best = fabs(A[i * n + k]); piv = i; }
+        if (!(best > 1e-13 * scale)) return AMBLE_ERR_SINGULAR_RESET;
+        if (piv != k) {
+            for (int j = 0; j < n; ++j) { double tmp = A[k * n + j]; A[k * n + j] = A[piv * n + j]; A[piv * n + j] = tmp; }
+            double tmp = b[k]; b[k] = b[piv]; b[piv] = tmp;
+        }
+        for (int i = k + 1; i < n; ++i) {
+            double f = A[i * n + k] / A[k * n + k];
+            if (f == 0.0) continue;
+            for (int j = k; j < n; ++j) A[i * n + j] -= f * A[k * n + j];
+            b[i] -= f * b[k];
+        }
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double v = b[i];
+        for (int j = i + 1; j < n; ++j) v -= A[i * n + j] * b[j];
+        b[i] = v / A[i * n + i];
+    }
+    return 0;
+}
+
+/* Plastic impulse: given the (extended) mass matrix Me (ne x ne), constraint Jacobian J
+ * (nc x ne, row-major) and the pre-impact velocity v (ne), overwrite v with the post-impact
+ * velocity solving  Me (v+ - v-) = J^T lambda,  J v+ = 0  (the KKT system of a perfectly
+ * plastic, non-sliding contact or a joint lock). */
+static int amble_impulse(int ne, int nc, const double *Me, const double *J, double *v) {
+    int nk = ne + nc;
+    double A[nk * nk];
+    double r[nk];
+    memset(A, 0, sizeof(double) * nk * nk);
+    for (int i = 0; i < ne; ++i) {
+        double s = 0.0;
+        for (int j = 0; j < ne; ++j) {
+            A[i * nk + j] = Me[i * ne + j];
+            s += Me[i * ne + j] * v[j];
+        }
+        r[i] = s;
+    }
+    for (int c = 0; c < nc; ++c) {
+        for (int j = 0; j < ne; ++j) {
+            A[(ne + c) * nk + j] = J[c * ne + j];
+            A[j * nk + ne + c] = -J[c * ne + j];
+        }
+        r[ne + c] = 0.0;
+    }
+    int err = amble_lu_solve(nk, A, r);
+    if (err) return err;
+    for (int i = 0; i < ne; ++i) v[i] = r[i];
+    return 0;
+}
+
+#endif

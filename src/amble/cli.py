@@ -1,0 +1,360 @@
+"""The ``amble`` command line: every command is one API call plus input/output.
+
+Exit codes: 0 success, 2 user error (bad model name, parameter, range, path...), 1 internal
+failure. Errors are one line on stderr, or ``{"error": ...}`` on stdout with ``--json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from .errors import AmbleError
+
+
+class UsageError(AmbleError):
+    """Bad command-line input."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2, no usage dump
+        raise UsageError(message)
+
+
+def _float(text: str, what: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise UsageError(f"{what}: {text!r} is not a number") from None
+    if not math.isfinite(v):
+        raise UsageError(f"{what}: {text!r} is not finite")
+    return v
+
+
+def parse_sets(items: Sequence[str] | None) -> dict[str, float]:
+    """``NAME=VALUE`` pairs → dict (values must be finite numbers)."""
+    out: dict[str, float] = {}
+    for item in items or []:
+        name, eq, val = item.partition("=")
+        if not eq or not name.strip():
+            raise UsageError(f"--set expects NAME=VALUE, got {item!r}")
+        out[name.strip()] = _float(val.strip(), f"--set {name.strip()}")
+    return out
+
+
+def parse_range(text: str) -> tuple[str, float, float, int]:
+    """``NAME=START:STOP:COUNT`` → (name, start, stop, count)."""
+    name, eq, rng = text.partition("=")
+    parts = rng.split(":")
+    if not eq or not name.strip() or len(parts) != 3:
+        raise UsageError(f"--param expects NAME=START:STOP:COUNT, got {text!r}")
+    start, stop = _float(parts[0], "range start"), _float(parts[1], "range stop")
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise UsageError(f"range count {parts[2]!r} is not an integer") from None
+    if count < 1:
+        raise UsageError(f"range count must be at least 1, got {count}")
+    if count > 1 and start == stop:
+        raise UsageError(f"empty range {start}:{stop} with {count} points")
+    return name.strip(), start, stop, count
+
+
+def _writable(path: str | None, suffixes: Sequence[str], what: str) -> Path | None:
+    if path is None:
+        return None
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise UsageError(f"{what}: {path!r} must end with one of {', '.join(suffixes)}")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"{what}: directory {str(parent)!r} does not exist")
+    try:
+        with open(p, "a"):
+            pass
+    except OSError as e:
+        raise UsageError(f"{what}: cannot write {path!r} ({e.strerror})") from None
+    return p
+
+
+def _load(name: str):
+    from .models import load
+
+    return load(name)
+
+
+# ---------------------------------------------------------------------- commands
+def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
+    from .models import REGISTRY, load
+
+    rows = []
+    for name in REGISTRY:
+        s = load(name)
+        first = s.mode_names[0]
+        rows.append({"name": name, "dims": s.dims, "modes": s.mode_names, "state_names": s.state_names(first),
+                     "parameters": s.parameters, "summary": (s.doc or "").strip().splitlines()[0] if s.doc else ""})
+    if not args.json:
+        for r in rows:
+            print(f"{r['name']:<16} {r['dims']}D  {len(r['state_names']) // 2} coordinates  {r['summary']}")
+    return {"models": rows}
+
+
+def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
+    import sympy as sp
+
+    from .equations import derive
+
+    s = _load(args.model)
+    out: dict[str, Any] = {"model": args.model, "modes": {}}
+    for mname, m in s.modes.items():
+        eq = derive(m)
+        g = m.gravity_vector
+        entry = {
+            "coordinates": [str(q) for q in m.q],
+            "velocities": [str(v) for v in m.qd],
+            "parameters": {str(k): v for k, v in m.params.items()},
+            "mass_matrix": [[sp.sstr(eq.M[i, j]) for j in range(eq.M.cols)] for i in range(eq.M.rows)],
+            "bias": [sp.sstr(e) for e in eq.h],
+            "generalized_force": [sp.sstr(e) for e in eq.Gamma],
+            "gravity_vector": [sp.sstr(e) for e in g],
+            "operation_count": eq.count_ops(),
+        }
+        if args.latex:
+            entry["latex"] = eq.latex()
+        out["modes"][mname] = entry
+    first = next(iter(out["modes"].values()))
+    out.update({k: first[k] for k in ("coordinates", "parameters", "mass_matrix", "bias", "gravity_vector")})
+    out["transitions"] = [{"name": tr.name, "source": tr.source, "target": tr.target,
+                           "reset": type(tr.reset).__name__ if tr.reset else None, "terminal": tr.terminal,
+                           "guard": sp.sstr(tr.guard.expr)} for tr in s.transitions]
+    if not args.json:
+        for mname, e in out["modes"].items():
+            print(f"mode {mname}: q = ({', '.join(e['coordinates'])})")
+            if args.latex:
+                print(e["latex"])
+            else:
+                for i, row in enumerate(e["mass_matrix"]):
+                    print(f"  M[{i}] = [{', '.join(row)}]")
+                for i, b in enumerate(e["bias"]):
+                    print(f"  h[{i}] = {b}")
+            print(f"  operations (shared subexpressions): {e['operation_count']}")
+        for tr in out["transitions"]:
+            print(f"transition {tr['name']}: {tr['source']} -> {tr['target']} ({tr['reset'] or tr['terminal']})")
+    return out
+
+
+def _start(s, text: str | None, params: dict[str, float]):
+    if text is None:
+        return None
+    if text == "fixed-point":
+        from .analysis.poincare import find_fixed_point
+
+        return find_fixed_point(s, params=params).fixed_point
+    if text.startswith("x0="):
+        vals = [v for v in text[3:].split(",") if v.strip()]
+        return [_float(v, "--start x0") for v in vals]
+    raise UsageError(f"--start expects 'fixed-point' or 'x0=V1,V2,...', got {text!r}")
+
+
+def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
+    from .simulate import simulate
+
+    out_p = _writable(args.out, (".csv", ".parquet", ".npz"), "--out")
+    plot_p = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    anim_p = _writable(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    if args.steps is not None and args.steps < 1:
+        raise UsageError(f"--steps must be at least 1, got {args.steps}")
+    if args.time is not None and not args.time > 0:
+        raise UsageError(f"--time must be positive, got {args.time}")
+    s = _load(args.model)
+    params = parse_sets(args.set)
+    x0 = _start(s, args.start, params)
+    steps = args.steps if (args.steps is not None or args.time is not None) else 20
+    tr = simulate(s, x0, params=params, steps=steps, t_end=args.time, rtol=args.rtol, atol=args.atol,
+                  sample_dt=1.0 / 200)
+    summary = tr.summary()
+    if out_p:
+        tr.save(out_p)
+        summary["out"] = str(out_p)
+    if plot_p:
+        from .viz.plot import plot_trajectory
+
+        plot_trajectory(tr, plot_p)
+        summary["plot"] = str(plot_p)
+    if anim_p:
+        from .viz.animate import animate
+
+        animate(s, tr, anim_p)
+        summary["animation"] = str(anim_p)
+    if not args.json:
+        print(f"{args.model}: {tr.status} — {tr.message}")
+        post = summary["final_post_impact_state"]
+        if post is not None:
+            print("post-impact state: " + ", ".join(f"{n}={v:.6g}" for n, v in zip(summary["state_names"], post)))
+        for k in ("out", "plot", "animation"):
+            if k in summary:
+                print(f"wrote {summary[k]}")
+    return summary
+
+
+def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
+    from .analysis.poincare import find_fixed_point
+
+    plot_p = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    anim_p = _writable(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    if args.period < 1:
+        raise UsageError(f"--period must be at least 1, got {args.period}")
+    s = _load(args.model)
+    params = parse_sets(args.set)
+    guess = _start(s, args.guess, params) if args.guess else None
+    lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
+    out = lc.to_json()
+    if plot_p or anim_p:
+        from .simulate import simulate
+
+        tr = simulate(s, lc.fixed_point, params=params, steps=max(args.period, 2) if plot_p and not anim_p else 12,
+                      rtol=args.rtol, atol=args.atol, sample_dt=1.0 / 200)
+        if plot_p:
+            from .viz.plot import plot_limit_cycle
+
+            plot_limit_cycle(tr, plot_p, cycle=lc)
+            out["plot"] = str(plot_p)
+        if anim_p:
+            from .viz.animate import animate
+
+            animate(s, tr, anim_p)
+            out["animation"] = str(anim_p)
+    if not args.json:
+        print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
+              f"step time {lc.step_time:.6g} s (residual {lc.residual:.1e}, {lc.iterations} iterations)")
+        print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
+        print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
+        for k in ("plot", "animation"):
+            if k in out:
+                print(f"wrote {out[k]}")
+    return out
+
+
+def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
+    from .analysis.sweep import sweep_cli
+
+    return sweep_cli(args)
+
+
+# ---------------------------------------------------------------------- parser
+EXAMPLES = {
+    "models": "amble models --json",
+    "equations": "amble equations compass-gait --latex",
+    "simulate": "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html",
+    "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
+    "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot bifurcation.png",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="amble", description="Equation-based modeling and simulation of walking robots.",
+                formatter_class=argparse.RawDescriptionHelpFormatter,
+                epilog="examples:\n  " + "\n  ".join(EXAMPLES.values()))
+    p.add_argument("--version", action="version", version=f"amble {_version()}")
+    sub = p.add_subparsers(dest="command", parser_class=_Parser, required=True)
+
+    def add(name: str, help_: str) -> argparse.ArgumentParser:
+        sp = sub.add_parser(name, help=help_, description=help_, epilog=f"example:\n  {EXAMPLES[name]}",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+        sp.add_argument("--json", action="store_true", help="print a JSON object on stdout")
+        return sp
+
+    def model_args(sp: argparse.ArgumentParser, tol: float) -> None:
+        sp.add_argument("model", help="model name (see 'amble models')")
+        sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+        sp.add_argument("--rtol", type=float, default=tol, help=f"relative tolerance (default {tol:g})")
+        sp.add_argument("--atol", type=float, default=tol, help=f"absolute tolerance (default {tol:g})")
+
+    add("models", "list the model library").set_defaults(func=cmd_models)
+    e = add("equations", "show the derived equations of motion and transitions of a model")
+    e.add_argument("model")
+    e.add_argument("--latex", action="store_true", help="LaTeX instead of plain text")
+    e.set_defaults(func=cmd_equations)
+    s = add("simulate", "simulate a model for N steps or T seconds")
+    model_args(s, 1e-10)
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--steps", type=int, help="number of footfalls (default 20)")
+    g.add_argument("--time", type=float, help="end time in seconds")
+    s.add_argument("--start", help="'fixed-point' or 'x0=V1,V2,...' (full state, state_names order)")
+    s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
+    s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
+    s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
+    s.set_defaults(func=cmd_simulate)
+    lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
+    model_args(lc, 1e-12)
+    lc.add_argument("--period", type=int, default=1, help="k for a period-k gait (default 1)")
+    lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
+    lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
+    lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
+    lc.set_defaults(func=cmd_limit_cycle)
+    sw = add("sweep", "parameter sweep: fixed points / bifurcation diagram, on Dask")
+    model_args(sw, 1e-10)
+    sw.add_argument("--param", action="append", required=True, metavar="NAME=START:STOP:COUNT",
+                    help="swept parameter (give one for a 1D sweep, two for a 2D map)")
+    sw.add_argument("--kind", choices=("fixed-point", "bifurcation"), default="fixed-point",
+                    help="continuation of the fixed point, or post-transient iterates (bifurcation)")
+    sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")
+    sw.add_argument("--plot", help="write a plot FILE.png|.svg|.pdf")
+    sw.add_argument("--scheduler", help="address of an existing Dask scheduler (default: local processes)")
+    sw.add_argument("--workers", type=int, default=None, help="local Dask worker processes (default: cores)")
+    sw.set_defaults(func=cmd_sweep)
+    return p
+
+
+def _version() -> str:
+    from . import __version__
+
+    return __version__
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    want_json = "--json" in argv
+    try:
+        args = build_parser().parse_args(argv)
+        result = args.func(args)
+        if args.json:
+            print(json.dumps(result, default=_jsonable))
+        return 0
+    except AmbleError as e:
+        msg = str(e).splitlines()[0] if str(e) else type(e).__name__
+        if want_json:
+            print(json.dumps({"error": msg, "type": type(e).__name__}))
+        print(f"amble: error: {msg}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("amble: interrupted", file=sys.stderr)
+        return 130
+    except SystemExit as e:  # --help / --version
+        return int(e.code or 0)
+    except Exception as e:  # an internal failure: say so in one line, keep exit code 1
+        if want_json:
+            print(json.dumps({"error": f"internal error: {type(e).__name__}: {e}", "type": "InternalError"}))
+        print(f"amble: internal error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+
+
+def _jsonable(o: Any) -> Any:
+    import numpy as np
+
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, complex):
+        return [o.real, o.imag]
+    return str(o)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

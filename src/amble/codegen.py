@@ -1,0 +1,303 @@
+"""C code generation: a hybrid system's kernels as one translation unit.
+
+Every kernel is emitted from sympy expressions after common-subexpression elimination, with
+coordinates read from the state array ``x`` (``x[i]`` = qᵢ, ``x[n+i]`` = q̇ᵢ) and parameters
+from ``p`` — parameters are run-time inputs, so changing a mass or a slope recompiles nothing.
+The generated unit includes ``hybrid.c``, the integrator and event loop, so the whole walking
+step is compiled together and the right-hand side is inlined into the integrator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+
+from .equations import Equations, derive
+from .errors import ModelError
+from .hybrid import Explicit, HybridSystem, Impact, Lock, target_exprs
+from .model import Model, t
+
+
+class _Printer(C99CodePrinter):
+    """C99 printer mapping symbols to array reads and avoiding pow() for small integer powers."""
+
+    def __init__(self, names: dict[sp.Symbol, str]) -> None:
+        super().__init__()
+        self._names = names
+
+    def _print_Symbol(self, expr: sp.Symbol) -> str:
+        name = self._names.get(expr)
+        return name if name is not None else super()._print_Symbol(expr)
+
+    def _print_Pow(self, expr: sp.Pow) -> str:
+        base, e = expr.base, expr.exp
+        if e.is_Integer and 2 <= int(e) <= 4:
+            b = self.parenthesize(base, 100)
+            return "(" + "*".join([b] * int(e)) + ")"
+        if e == -1:
+            return f"(1.0/{self.parenthesize(base, 100)})"
+        return super()._print_Pow(expr)
+
+
+@dataclass
+class ModeInfo:
+    model: Model
+    equations: Equations
+    index: int
+
+
+def _names(model: Model, params: list[str]) -> dict[sp.Symbol, str]:
+    n = len(model.q)
+    names: dict[sp.Symbol, str] = {t: "t"}
+    for i, s in enumerate(model.q):
+        names[s] = f"x[{i}]"
+    for i, s in enumerate(model.qd):
+        names[s] = f"x[{n + i}]"
+    for s in model.params:
+        names[s] = f"p[{params.index(str(s))}]"
+    return names
+
+
+def _block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ") -> str:
+    """C statements assigning ``exprs`` to ``targets`` with shared subexpressions."""
+    if not exprs:
+        return ""
+    repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
+    pr = _Printer(names)
+    lines = [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
+    lines += [f"{indent}{tgt} = {pr.doprint(e)};" for tgt, e in zip(targets, reduced)]
+    return "\n".join(lines) + "\n"
+
+
+def _bool_block(expr: sp.Basic, names: dict[sp.Symbol, str]) -> str:
+    pr = _Printer(names)
+    return pr.doprint(expr)
+
+
+def _extended_impact_data(model: Model, eq: Equations, point: str) -> tuple[sp.Matrix, sp.Matrix]:
+    """Mass matrix and contact Jacobian of the model extended with its base (stance-foot) position.
+
+    Extended coordinates are ``(q, b)``, every position shifted by ``b``: with ``S = Σ mᵢ Jᵢᵀ`` and
+    total mass ``mₜ``, ``M_e = [[M, S], [Sᵀ, mₜ I]]`` and the impacting point has ``J = [J_c, I]``.
+    """
+    if model._k_override is not None or model._l_override is not None:
+        raise ModelError(
+            f"model {model.name!r}: an Impact reset needs the kinetic energy from point masses "
+            "(K or L was given outright); give an Explicit reset instead"
+        )
+    # Added kinetic terms (rotational inertia) do not depend on the base translation, so they
+    # stay in the q-block M and contribute nothing to the base blocks.
+    n, d = len(model.q), model.dims
+    S = sp.zeros(n, d)
+    mt = sp.Integer(0)
+    for name, m in model.masses.items():
+        J = model.points[name].jacobian(model.q)
+        S += m * J.T
+        mt += m
+    Me = sp.zeros(n + d, n + d)
+    Me[:n, :n] = eq.M
+    Me[:n, n:] = S
+    Me[n:, :n] = S.T
+    Me[n:, n:] = mt * sp.eye(d)
+    Jc = sp.zeros(d, n + d)
+    Jc[:, :n] = model.points[point].jacobian(model.q)
+    Jc[:, n:] = sp.eye(d)
+    return Me, Jc
+
+
+def generate(system: HybridSystem) -> tuple[str, dict]:
+    """Generate the C source of a system; returns (source, metadata for the loader)."""
+    params = list(system.parameters)
+    modes = {name: ModeInfo(m, derive(m), i) for i, (name, m) in enumerate(system.modes.items())}
+    points = system.point_names
+    nx = [2 * len(mi.model.q) for mi in modes.values()]
+    trs_by_mode = {name: [tr for tr in system.transitions if tr.source == name] for name in modes}
+    order = [tr for name in modes for tr in trs_by_mode[name]]
+    tr0, acc = [], 0
+    for name in modes:
+        tr0.append(acc)
+        acc += len(trs_by_mode[name])
+    ntr = len(order)
+
+    out: list[str] = []
+    w = out.append
+    w('#include "amble_core.h"\n')
+    w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
+    w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
+    w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
+    w(f"static const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")
+    w(f"static const int MODE_TR0[NMODES] = {{{', '.join(map(str, tr0))}}};\n")
+    arr = lambda vals: ", ".join(map(str, vals)) if vals else "0"
+    w(f"static const int TR_DIR[NTR > 0 ? NTR : 1] = {{{arr([tr.guard.direction for tr in order])}}};\n")
+    w(f"static const int TR_TERMINAL[NTR > 0 ? NTR : 1] = {{{arr([int(tr.terminal is not None) for tr in order])}}};\n")
+    w(f"static const int TR_STEP[NTR > 0 ? NTR : 1] = {{{arr([int(tr.step) for tr in order])}}};\n\n")
+
+    for name, mi in modes.items():
+        m, eq, k = mi.model, mi.equations, mi.index
+        n = len(m.q)
+        nm = _names(m, params)
+        # right-hand side: q̈ = M⁻¹ (Γ − h)
+        tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)]
+        ex = [eq.M[i, j] for i in range(n) for j in range(i + 1)]
+        tg += [f"f[{i}]" for i in range(n)]
+        ex += [eq.Gamma[i] - eq.h[i] for i in range(n)]
+        w(f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n")
+        w(f"    double M[{n * n}], f[{n}];\n    (void)t; (void)p;\n")
+        w(_block(tg, ex, nm))
+        w(f"    int err = amble_chol_solve({n}, M, f);\n")
+        w(f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n")
+        w("    return err;\n}\n")
+        # guards of this mode's transitions
+        trs = trs_by_mode[name]
+        w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")
+        w("    (void)t; (void)x; (void)p; (void)g;\n")
+        w(_block([f"g[{i}]" for i in range(len(trs))], [sp.sympify(tr.guard.expr) for tr in trs], nm))
+        w("}\n")
+        # time derivatives of the guards along the flow, ġ = ∇ₓg · ẋ + ∂g/∂t (ẋ given as dx)
+        xs = [*m.q, *m.qd]
+        dxs = [sp.Symbol(f"dx_{j}", real=True) for j in range(2 * n)]
+        nm_d = dict(nm)
+        nm_d.update({d: f"dx[{j}]" for j, d in enumerate(dxs)})
+        gdot = []
+        for tr in trs:
+            ge = sp.sympify(tr.guard.expr)
+            gdot.append(sp.diff(ge, t) + sum((sp.diff(ge, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)))
+        w(f"static void guards_dot_{k}(double t, const double *x, const double *dx, const double *p, double *g) {{\n")
+        w("    (void)t; (void)x; (void)dx; (void)p; (void)g;\n")
+        w(_block([f"g[{i}]" for i in range(len(trs))], gdot, nm_d))
+        w("}\n")
+        # energies
+        if eq.K is not None:
+            e_ex = [eq.K, eq.V]
+        else:
+            e_ex = [eq.energy, sp.Integer(0)]
+        w(f"static void energy_{k}(double t, const double *x, const double *p, double *out) {{\n")
+        w("    (void)t; (void)p;\n")
+        w(_block(["out[0]", "out[1]"], e_ex, nm))
+        w("}\n")
+        # kinematics of named points (3 components each; 2D models have y = 0)
+        tg, ex = [], []
+        for j, pname in enumerate(points):
+            if pname not in m.points:
+                continue
+            pos = m.points[pname]
+            vel = m.dt(pos)
+            comps = [pos[0], 0, pos[1]] if m.dims == 2 else list(pos)
+            vcomps = [vel[0], 0, vel[1]] if m.dims == 2 else list(vel)
+            for c in range(3):
+                tg += [f"pos[{3 * j + c}]", f"vel[{3 * j + c}]"]
+                ex += [sp.sympify(comps[c]), sp.sympify(vcomps[c])]
+        w(f"static void kinematics_{k}(double t, const double *x, const double *p, double *pos, double *vel) {{\n")
+        w("    (void)t; (void)x; (void)p;\n")
+        w(f"    for (int i = 0; i < {3 * len(points)}; ++i) {{ pos[i] = NAN; vel[i] = NAN; }}\n")
+        w(_block(tg, ex, nm))
+        w("}\n\n")
+
+    # transitions: enabling conditions and resets
+    for i, tr in enumerate(order):
+        src = modes[tr.source]
+        nm = _names(src.model, params)
+        cond = "1" if tr.guard.enabled is None else _bool_block(sp.sympify(tr.guard.enabled), nm)
+        w(f"static int enabled_{i}(double t, const double *x, const double *p) {{\n")
+        w(f"    (void)t; (void)x; (void)p;\n    return ({cond}) ? 1 : 0;\n}}\n")
+        w(_reset_code(i, tr, src, modes, nm, params))
+
+    # dispatchers
+    def dispatch(sig: str, ret: str, call: str, names: list[str], key: str) -> None:
+        w(f"static {ret} {sig} {{\n    switch ({key}) {{\n")
+        for j, _ in enumerate(names):
+            r = "return " if ret != "void" else ""
+            brk = "" if ret != "void" else " break;"
+            w(f"    case {j}: {r}{call.format(j)};{brk}\n")
+        w("    }\n")
+        if ret != "void":
+            w("    return -1;\n")
+        w("}\n")
+
+    mode_list = list(modes)
+    dispatch("rhs(int mode, double t, const double *x, const double *p, double *dx)", "int",
+             "rhs_{}(t, x, p, dx)", mode_list, "mode")
+    dispatch("guards(int mode, double t, const double *x, const double *p, double *g)", "void",
+             "guards_{}(t, x, p, g)", mode_list, "mode")
+    dispatch("guards_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g)",
+             "void", "guards_dot_{}(t, x, dx, p, g)", mode_list, "mode")
+    dispatch("energy(int mode, double t, const double *x, const double *p, double *out)", "void",
+             "energy_{}(t, x, p, out)", mode_list, "mode")
+    dispatch("kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel)",
+             "void", "kinematics_{}(t, x, p, pos, vel)", mode_list, "mode")
+    dispatch("enabled(int tr, double t, const double *x, const double *p)", "int",
+             "enabled_{}(t, x, p)", [tr.name for tr in order], "tr")
+    dispatch("reset(int tr, double t, const double *x, const double *p, double *xout, int *target)", "int",
+             "reset_{}(t, x, p, xout, target)", [tr.name for tr in order], "tr")
+    w('\n#include "hybrid.c"\n')
+
+    meta = {
+        "name": system.name,
+        "modes": mode_list,
+        "nx": nx,
+        "params": params,
+        "param_defaults": [system.parameters[p] for p in params],
+        "points": points,
+        "state_names": {mn: system.modes[mn].state_names for mn in mode_list},
+        "transitions": [
+            {
+                "name": tr.name,
+                "source": tr.source,
+                "target": tr.target,
+                "terminal": tr.terminal,
+                "step": tr.step,
+                "shift": (tr.reset.shift_point if tr.reset is not None else None),
+            }
+            for tr in order
+        ],
+        "dims": system.dims,
+    }
+    return "".join(out), meta
+
+
+def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict, params: list[str]) -> str:
+    head = f"static int reset_{i}(double t, const double *x, const double *p, double *xout, int *target) {{\n"
+    head += "    (void)t; (void)x; (void)p; (void)xout;\n"
+    if tr.reset is None:
+        return head + f"    *target = {src.index};\n    return 0;\n}}\n"
+    dst = modes[tr.target]
+    m, eq = src.model, src.equations
+    n, nd = len(m.q), len(dst.model.q)
+    what = f"reset of transition {tr.name!r}"
+    body = f"    *target = {dst.index};\n"
+    reset = tr.reset
+    if isinstance(reset, Explicit):
+        qn = target_exprs(dst.model, reset.q, what)
+        vn = target_exprs(dst.model, reset.qd, what, velocities=True)
+        body += f"    double y[{2 * nd}];\n"
+        body += _block([f"y[{j}]" for j in range(2 * nd)], qn + vn, nm)
+        body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
+        return head + body + "}\n"
+    if isinstance(reset, Impact):
+        Me, Jc = _extended_impact_data(m, eq, reset.point)
+    elif isinstance(reset, Lock):
+        Me = eq.M
+        Jc = sp.Matrix([[sp.diff(sp.sympify(reset.constraint), qi) for qi in m.q]])
+    else:  # pragma: no cover - validated earlier
+        raise ModelError(f"{what}: unsupported reset {reset!r}")
+    ne, nc = Me.shape[0], Jc.shape[0]
+    qn = target_exprs(dst.model, reset.relabel, what)
+    dq = sp.Matrix(qn).jacobian(m.q)  # velocity map of the relabelling
+    body += f"    double Me[{ne * ne}], Jc[{nc * ne}], v[{ne}], qn[{nd}], T[{nd * n}];\n"
+    tg = [f"Me[{a * ne + b}]" for a in range(ne) for b in range(ne)]
+    ex = [Me[a, b] for a in range(ne) for b in range(ne)]
+    tg += [f"Jc[{a * ne + b}]" for a in range(nc) for b in range(ne)]
+    ex += [Jc[a, b] for a in range(nc) for b in range(ne)]
+    tg += [f"qn[{a}]" for a in range(nd)]
+    ex += qn
+    tg += [f"T[{a * n + b}]" for a in range(nd) for b in range(n)]
+    ex += [dq[a, b] for a in range(nd) for b in range(n)]
+    body += _block(tg, ex, nm)
+    body += f"    for (int j = 0; j < {ne}; ++j) v[j] = j < {n} ? x[{n} + j] : 0.0;\n"
+    body += f"    int err = amble_impulse({ne}, {nc}, Me, Jc, v);\n    if (err) return err;\n"
+    body += f"    for (int a = 0; a < {nd}; ++a) {{\n        double s = 0.0;\n"
+    body += f"        for (int b = 0; b < {n}; ++b) s += T[a * {n} + b] * v[b];\n"
+    body += f"        xout[a] = qn[a];\n        xout[{nd} + a] = s;\n    }}\n    return 0;\n"
+    return head + body + "}\n"

@@ -1,0 +1,35 @@
+"""Typed exceptions raised by amble.
+
+Every error a user can cause derives from :class:`AmbleError`, so scripts can catch one type;
+the command-line tool turns these into a one-line message and exit code 2.
+"""
+
+from __future__ import annotations
+
+
+class AmbleError(Exception):
+    """Base class of all errors amble raises on purpose."""
+
+
+class ModelError(AmbleError, ValueError):
+    """The model is ill-formed: unknown symbols, bad masses, inconsistent resets, ..."""
+
+
+class ParameterError(AmbleError, ValueError):
+    """A parameter name is unknown or its value is not acceptable."""
+
+
+class StateError(AmbleError, ValueError):
+    """A state vector has the wrong length or non-finite entries."""
+
+
+class CompileError(AmbleError, RuntimeError):
+    """Generated code could not be compiled (no C compiler, or the compiler failed)."""
+
+
+class SimulationError(AmbleError, RuntimeError):
+    """A simulation could not be carried out (as opposed to ending with a status such as ``fell``)."""
+
+
+class ConvergenceError(AmbleError, RuntimeError):
+    """An iterative method (e.g. the fixed-point search) did not converge."""

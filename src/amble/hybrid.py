@@ -1,0 +1,281 @@
+"""Hybrid systems: modes, guards (witness functions) and resets, kept apart.
+
+A :class:`HybridSystem` is a set of modes — each a :class:`~amble.model.Model` with its own
+coordinates — and transitions between them. A transition has
+
+* a :class:`Guard`: a witness function ``g(q, q̇, t)`` of the source mode; the transition fires
+  where ``g`` crosses zero in the guard's direction (default: from positive to non-positive, the
+  thesis' Eq. 14 ``h ≤ 0, ḣ ≤ 0``) and its optional enabling condition holds there;
+* a reset, one of
+  - :class:`Impact`: a perfectly plastic, non-sliding impact of a named point with the ground,
+    derived from the model (floating-base impulse), followed by a relabelling of coordinates;
+  - :class:`Lock`: an impulsive constraint ``c(q) = 0`` (a knee lock), followed by a change to a
+    mode with fewer coordinates;
+  - :class:`Explicit`: new ``q`` and ``q̇`` written out by the user (e.g. the thesis' ``J(q)`` and
+    ``H_g``);
+  or no reset and a terminal status (``fell``): the run ends there.
+
+Everything here is a declaration; :mod:`amble.codegen` turns it into compiled code.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import sympy as sp
+
+from .errors import ModelError
+from .model import Model
+
+
+@dataclass(frozen=True)
+class Guard:
+    """Witness function of a transition.
+
+    Parameters
+    ----------
+    expr:
+        ``g(q, q̇, t)`` in the source mode's symbols.
+    direction:
+        ``-1``: fires when ``g`` goes from ``> 0`` to ``≤ 0`` (default); ``+1``: from ``< 0`` to
+        ``≥ 0``; ``0``: either way.
+    enabled:
+        Optional sympy boolean (e.g. ``foot_x > 0``) that must hold at the crossing; crossings
+        where it is false are ignored (a swing foot scuffing behind the stance foot).
+    """
+
+    expr: Any
+    direction: int = -1
+    enabled: Any = None
+
+
+class Reset:
+    """Base class of resets."""
+
+    #: name of the point whose pre-event position becomes the new origin (None: no shift)
+    shift_point: str | None = None
+
+
+@dataclass
+class Impact(Reset):
+    """Plastic impact of ``point`` with the ground, then relabelling.
+
+    The post-impact velocity solves ``M_e (q̇e⁺ − q̇e⁻) = Jᵀλ, J q̇e⁺ = 0`` for the model extended
+    with the stance-foot position (which may now lift off), ``J`` being the Jacobian of the
+    impacting point in the extended coordinates. ``relabel`` gives each coordinate of the
+    target mode as an expression of the source coordinates (e.g. ``{stance: swing,
+    swing: stance}``); velocities follow by the chain rule.
+    """
+
+    point: str
+    relabel: Mapping[Any, Any]
+
+    @property
+    def shift_point(self) -> str:  # type: ignore[override]
+        return self.point
+
+
+@dataclass
+class Lock(Reset):
+    """Impulsive constraint ``c(q) = 0`` (e.g. a knee lock ``shank − thigh``), then relabelling.
+
+    The impulse solves ``M (q̇⁺ − q̇⁻) = ∇cᵀλ, ∇c q̇⁺ = 0``; ``relabel`` gives the target
+    mode's coordinates in terms of the source coordinates.
+    """
+
+    constraint: Any
+    relabel: Mapping[Any, Any]
+
+
+@dataclass
+class Explicit(Reset):
+    """A reset written out: target coordinates and velocities as expressions of the source state.
+
+    ``q`` and ``qd`` are mappings target-name → expression, or sequences in target order (a
+    sympy Matrix such as ``J*q`` or ``H_g*q̇`` works). ``shift`` optionally names a point whose
+    pre-event position becomes the new origin (the new stance foot).
+    """
+
+    q: Any
+    qd: Any
+    shift: str | None = None
+
+    @property
+    def shift_point(self) -> str | None:  # type: ignore[override]
+        return self.shift
+
+
+@dataclass
+class Transition:
+    name: str
+    source: str
+    target: str
+    guard: Guard
+    reset: Reset | None
+    terminal: str | None = None
+    step: bool = False
+
+
+@dataclass
+class HybridSystem:
+    """Modes and transitions of a hybrid mechanical system.
+
+    ``modes`` maps a mode name to its model (a single :class:`Model` makes one mode named after
+    it). The first mode is the default initial mode. ``ground_slope`` (a parameter symbol or a
+    number, radians) tells drawing code where the walking surface is.
+    """
+
+    name: str
+    modes: dict[str, Model]
+    transitions: list[Transition] = field(default_factory=list)
+    ground_slope: Any = 0.0
+    default_start: dict[str, Sequence[float]] = field(default_factory=dict)
+    fixed_point_guess: Sequence[float] | None = None
+    hip: str | None = None
+    look: list[Any] = field(default_factory=list)
+    doc: str = ""
+
+    def __post_init__(self) -> None:
+        if isinstance(self.modes, Model):
+            self.modes = {self.modes.name: self.modes}
+        if not self.modes:
+            raise ModelError(f"system {self.name!r} has no modes")
+        dims = {m.dims for m in self.modes.values()}
+        if len(dims) != 1:
+            raise ModelError(f"system {self.name!r}: modes mix 2D and 3D models")
+        self.parameters  # validates consistent defaults
+
+    # ------------------------------------------------------------------ declaring
+    def transition(
+        self,
+        name: str,
+        source: str,
+        guard: Guard,
+        reset: Reset,
+        target: str | None = None,
+        *,
+        step: bool = False,
+    ) -> Transition:
+        """Add a transition ``source → target`` fired by ``guard``; ``step`` marks a footfall."""
+        target = target or source
+        self._check_mode(source)
+        self._check_mode(target)
+        self._check_guard(source, guard)
+        _check_reset(self.modes[source], self.modes[target], reset, name)
+        tr = Transition(name, source, target, guard, reset, None, step)
+        self.transitions.append(tr)
+        return tr
+
+    def terminal(self, name: str, source: str, guard: Guard, status: str = "fell") -> Transition:
+        """Add a guard that ends the run with ``status`` (e.g. the hip touching the ground)."""
+        self._check_mode(source)
+        self._check_guard(source, guard)
+        tr = Transition(name, source, source, guard, None, status, False)
+        self.transitions.append(tr)
+        return tr
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def dims(self) -> int:
+        return next(iter(self.modes.values())).dims
+
+    @property
+    def mode_names(self) -> list[str]:
+        return list(self.modes)
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """All parameters of all modes (name → default), in declaration order."""
+        out: dict[str, float] = {}
+        for m in self.modes.values():
+            for s, v in m.params.items():
+                k = str(s)
+                if k in out and out[k] != v:
+                    raise ModelError(
+                        f"system {self.name!r}: parameter {k!r} has defaults {out[k]} and {v} in different modes"
+                    )
+                out[k] = v
+        return out
+
+    def state_names(self, mode: str | None = None) -> list[str]:
+        """State names of a mode (default: the first): coordinates, then velocities."""
+        return self.modes[mode or self.mode_names[0]].state_names
+
+    @property
+    def point_names(self) -> list[str]:
+        names: list[str] = []
+        for m in self.modes.values():
+            for p in m.points:
+                if p not in names:
+                    names.append(p)
+        return names
+
+    def _check_mode(self, mode: str) -> None:
+        if mode not in self.modes:
+            raise ModelError(f"system {self.name!r}: unknown mode {mode!r} (modes: {', '.join(self.modes)})")
+
+    def _check_guard(self, source: str, guard: Guard) -> None:
+        m = self.modes[source]
+        if guard.direction not in (-1, 0, 1):
+            raise ModelError(f"system {self.name!r}: guard direction must be -1, 0 or +1")
+        expr = sp.sympify(guard.expr)
+        allowed = set(m.q) | set(m.qd) | set(m.params) | {sp.Symbol("t", real=True)}
+        if not (expr.free_symbols & (set(m.q) | set(m.qd))):
+            raise ModelError(
+                f"system {self.name!r}: a guard of mode {source!r} does not depend on the state: {expr}"
+            )
+        for e in (expr, sp.sympify(guard.enabled) if guard.enabled is not None else sp.true):
+            bad = sorted(str(s) for s in e.free_symbols - allowed)
+            if bad:
+                raise ModelError(
+                    f"system {self.name!r}: guard of mode {source!r} uses unknown symbols {', '.join(bad)}"
+                )
+
+
+def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = False) -> list[sp.Expr]:
+    """Order a relabel mapping (or sequence) by the target mode's coordinates."""
+    names = [str(s) for s in (target.qd if velocities else target.q)]
+    if isinstance(mapping, Mapping):
+        given = {str(k): sp.sympify(v) for k, v in mapping.items()}
+        unknown = sorted(set(given) - set(names))
+        if unknown:
+            raise ModelError(f"{what}: {', '.join(unknown)} not among the target coordinates {names}")
+        missing = [n for n in names if n not in given]
+        if missing:
+            raise ModelError(f"{what}: no value for target coordinate(s) {', '.join(missing)}")
+        return [given[n] for n in names]
+    seq = [sp.sympify(v) for v in (list(mapping) if not isinstance(mapping, sp.MatrixBase) else list(mapping))]
+    if len(seq) != len(names):
+        raise ModelError(f"{what}: {len(seq)} values for {len(names)} target coordinates")
+    return seq
+
+
+def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
+    what = f"reset of transition {name!r}"
+    if isinstance(reset, Impact):
+        if reset.point not in src.points:
+            raise ModelError(f"{what}: impact point {reset.point!r} is not a point of mode {src.name!r}")
+        exprs = target_exprs(dst, reset.relabel, what)
+        _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
+    elif isinstance(reset, Lock):
+        c = sp.sympify(reset.constraint)
+        if not (c.free_symbols & set(src.q)):
+            raise ModelError(f"{what}: lock constraint {c} does not depend on the coordinates")
+        exprs = target_exprs(dst, reset.relabel, what)
+        _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
+    elif isinstance(reset, Explicit):
+        exprs = target_exprs(dst, reset.q, what) + target_exprs(dst, reset.qd, what, velocities=True)
+        _check_free(exprs, set(src.q) | set(src.qd) | set(src.params) | {sp.Symbol("t", real=True)}, what, "source state")
+        if reset.shift is not None and reset.shift not in src.points:
+            raise ModelError(f"{what}: shift point {reset.shift!r} is not a point of mode {src.name!r}")
+    else:
+        raise ModelError(f"{what}: expected Impact, Lock or Explicit, got {type(reset).__name__}")
+
+
+def _check_free(exprs: list[sp.Expr], allowed: set, what: str, label: str) -> None:
+    for e in exprs:
+        bad = sorted(str(s) for s in e.free_symbols - allowed)
+        if bad:
+            raise ModelError(f"{what}: uses {', '.join(bad)}, not among the {label} or parameters")

@@ -1,0 +1,355 @@
+"""The equation-based model: coordinates, parameters, points, masses, energies and forces.
+
+A :class:`Model` holds what one writes on paper for a mechanical system in one contact mode:
+
+* generalized coordinates ``q`` (sympy symbols; their velocities are the symbols ``<name>_dot``),
+* parameters with default values (they stay symbols: compiled kernels take them at run time),
+* named points given as 2D ``(x, z)`` or 3D ``(x, y, z)`` position expressions of ``q``,
+  optionally carrying a point mass,
+* extra kinetic / potential energy terms, or ``K`` and ``V`` (or ``L``) given outright,
+* generalized forces Γ(q, q̇, t), including piecewise ones.
+
+Conventions: SI units, angles in radians. The world frame has ``x`` forward, ``y`` to the left
+(3D only), ``z`` up; gravity points along ``-z`` unless :meth:`Model.gravity` says otherwise.
+2D models live in the x–z plane. A slope is a *rotated ground*, not a rotated gravity: positions
+and angles are written against the true vertical, and the walking surface is a plane through
+the stance foot descending along ``+x`` (see :mod:`amble.walker`). That keeps angles in the
+convention of the thesis and of Drake (from the vertical, positive in the walking direction).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+import sympy as sp
+
+from .errors import ModelError
+
+#: The time symbol, for explicitly time-dependent forces Γ(q, q̇, t).
+t = sp.Symbol("t", real=True)
+
+
+def R(theta: sp.Expr) -> sp.Matrix:
+    """2D unit vector at angle ``theta`` from the vertical, clockwise positive (thesis Eq. 6).
+
+    Returns ``(sin θ, cos θ)`` as an ``(x, z)`` column: the direction from a foot to the hip
+    of a leg leaning forward by ``theta``.
+    """
+    return sp.Matrix([sp.sin(theta), sp.cos(theta)])
+
+
+def R3(theta: sp.Expr, phi: sp.Expr) -> sp.Matrix:
+    """3D unit vector of thesis Eq. 37: ``(sin Θ cos Φ, sin Φ, cos Θ cos Φ)`` in ``(x, y, z)``.
+
+    ``Θ`` tilts the vector forward (sagittal plane), ``Φ`` sideways (coronal plane, towards +y).
+    """
+    return sp.Matrix([sp.sin(theta) * sp.cos(phi), sp.sin(phi), sp.cos(theta) * sp.cos(phi)])
+
+
+def vector(*components: Any) -> sp.Matrix:
+    """A column vector from components (numbers or sympy expressions)."""
+    if len(components) == 1 and isinstance(components[0], Iterable):
+        components = tuple(components[0])
+    return sp.Matrix([sp.sympify(c) for c in components])
+
+
+class Model:
+    """A mechanical system in one mode, written as positions, masses and energies.
+
+    Parameters
+    ----------
+    name:
+        A short identifier (used in messages and cache keys).
+    dims:
+        2 for planar models (points are ``(x, z)``), 3 for spatial ones (``(x, y, z)``).
+    """
+
+    def __init__(self, name: str, dims: int = 2) -> None:
+        if dims not in (2, 3):
+            raise ModelError(f"model {name!r}: dims must be 2 or 3, got {dims!r}")
+        self.name = name
+        self.dims = dims
+        self.q: list[sp.Symbol] = []
+        self.qd: list[sp.Symbol] = []
+        self.params: dict[sp.Symbol, float] = {}
+        self.param_docs: dict[str, str] = {}
+        self.points: dict[str, sp.Matrix] = {}
+        self.masses: dict[str, sp.Expr] = {}
+        self.links: list[tuple[str, str]] = []
+        self._k_terms: list[sp.Expr] = []
+        self._v_terms: list[sp.Expr] = []
+        self._k_override: sp.Expr | None = None
+        self._v_override: sp.Expr | None = None
+        self._l_override: sp.Expr | None = None
+        self._forces: list[sp.Matrix] = []
+        self._force_vectors: list[tuple[str, sp.Matrix]] = []
+        self._g: sp.Expr = sp.Integer(0)
+        self._g_dir: sp.Matrix = self._down()
+        self.look: list[Any] = []
+
+    # ------------------------------------------------------------------ symbols
+    def coordinates(self, names: str | Sequence[str]) -> tuple[sp.Symbol, ...]:
+        """Declare generalized coordinates; returns their symbols (velocities: :meth:`dot`)."""
+        if isinstance(names, str):
+            names = names.replace(",", " ").split()
+        out = []
+        for n in names:
+            if any(str(s) == n for s in self.q) or any(str(s) == n for s in self.params):
+                raise ModelError(f"model {self.name!r}: name {n!r} declared twice")
+            s = sp.Symbol(n, real=True)
+            self.q.append(s)
+            self.qd.append(sp.Symbol(f"{n}_dot", real=True))
+            out.append(s)
+        return tuple(out)
+
+    def parameters(self, **defaults: float) -> tuple[sp.Symbol, ...]:
+        """Declare parameters with default values, in keyword order; returns their symbols."""
+        return tuple(self.parameter(k, v) for k, v in defaults.items())
+
+    def parameter(self, name: str, default: float, doc: str = "") -> sp.Symbol:
+        """Declare one parameter with its default value and an optional description (with unit)."""
+        if any(str(s) == name for s in self.q) or any(str(s) == name for s in self.params):
+            raise ModelError(f"model {self.name!r}: name {name!r} declared twice")
+        try:
+            value = float(default)
+        except (TypeError, ValueError):
+            raise ModelError(
+                f"model {self.name!r}: default of parameter {name!r} must be a number, got {default!r}"
+            ) from None
+        s = sp.Symbol(name, real=True)
+        self.params[s] = value
+        if doc:
+            self.param_docs[name] = doc
+        return s
+
+    def dot(self, coordinate: sp.Symbol) -> sp.Symbol:
+        """The velocity symbol of a coordinate (named ``<coordinate>_dot``)."""
+        try:
+            return self.qd[self.q.index(coordinate)]
+        except ValueError:
+            raise ModelError(f"model {self.name!r}: {coordinate} is not a coordinate") from None
+
+    def dt(self, expr: Any) -> Any:
+        """Total time derivative of an expression (or vector) of q and t, by the chain rule."""
+        if isinstance(expr, sp.MatrixBase):
+            return expr.applyfunc(self.dt)
+        expr = sp.sympify(expr)
+        out = sp.diff(expr, t)
+        for qi, vi in zip(self.q, self.qd):
+            d = sp.diff(expr, qi)
+            if d != 0:
+                out += d * vi
+        return out
+
+    # ------------------------------------------------------------------ geometry
+    def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
+        """Name a point at ``position`` (2 or 3 components); optionally put a point mass there and
+        draw a rigid link to an earlier point (``link``).
+
+        Returns the position as a column vector so that later points can be built from it.
+        """
+        pos = position if isinstance(position, sp.MatrixBase) else vector(*position)
+        pos = sp.Matrix(pos)
+        if pos.shape != (self.dims, 1):
+            raise ModelError(
+                f"model {self.name!r}: point {name!r} has {len(pos)} components, "
+                f"expected {self.dims} for a {self.dims}D model"
+            )
+        if name in self.points:
+            raise ModelError(f"model {self.name!r}: point {name!r} defined twice")
+        self._check_symbols(pos, f"position of point {name!r}")
+        self.points[name] = pos
+        if mass is not None:
+            self.mass(name, mass)
+        if link is not None:
+            self.link(link, name)
+        return pos
+
+    def mass(self, point: str, m: Any) -> None:
+        """Put a point mass ``m`` (kg) at the named point."""
+        if point not in self.points:
+            raise ModelError(f"model {self.name!r}: mass placed at unknown point {point!r}")
+        m = sp.sympify(m)
+        self._check_symbols(m, f"mass at {point!r}")
+        self.masses[point] = self.masses.get(point, sp.Integer(0)) + m
+
+    def link(self, a: str, b: str) -> None:
+        """Declare a rigid link between two named points (used for drawing)."""
+        for p in (a, b):
+            if p not in self.points:
+                raise ModelError(f"model {self.name!r}: link to unknown point {p!r}")
+        self.links.append((a, b))
+
+    def inertia(self, angle: Any, moment: Any) -> None:
+        """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
+        self._k_terms.append(sp.Rational(1, 2) * sp.sympify(moment) * self.dt(angle) ** 2)
+
+    # ------------------------------------------------------------------ energies
+    def gravity(self, g: Any, direction: Any = None) -> None:
+        """Uniform gravity of magnitude ``g`` (m/s²) along ``direction`` (default: down, -z)."""
+        self._g = sp.sympify(g)
+        if direction is not None:
+            d = sp.Matrix(direction)
+            if d.shape != (self.dims, 1):
+                raise ModelError(f"model {self.name!r}: gravity direction needs {self.dims} components")
+            self._g_dir = d
+        self._check_symbols(self._g, "gravity")
+
+    def add_kinetic(self, expr: Any) -> None:
+        """Add a kinetic-energy term (J) in q and the velocity symbols."""
+        self._k_terms.append(sp.sympify(expr))
+
+    def add_potential(self, expr: Any) -> None:
+        """Add a potential-energy term (J) in q, e.g. a spring ``k*(q1 - q2)**2/2``."""
+        self._v_terms.append(sp.sympify(expr))
+
+    @property
+    def K(self) -> sp.Expr:
+        """Kinetic energy: Σ ½ mᵢ |ṗᵢ|² plus added terms, unless given outright."""
+        if self._k_override is not None:
+            return self._k_override
+        k = sp.Integer(0)
+        for name, m in self.masses.items():
+            v = self.dt(self.points[name])
+            k += sp.Rational(1, 2) * m * (v.T * v)[0, 0]
+        return k + sum(self._k_terms, sp.Integer(0))
+
+    @K.setter
+    def K(self, expr: Any) -> None:
+        self._k_override = sp.sympify(expr)
+
+    @property
+    def V(self) -> sp.Expr:
+        """Potential energy: Σ −mᵢ g·pᵢ plus added terms, unless given outright."""
+        if self._v_override is not None:
+            return self._v_override
+        v = sp.Integer(0)
+        gvec = self.gravity_vector
+        for name, m in self.masses.items():
+            v += -m * (gvec.T * self.points[name])[0, 0]
+        return v + sum(self._v_terms, sp.Integer(0))
+
+    @V.setter
+    def V(self, expr: Any) -> None:
+        self._v_override = sp.sympify(expr)
+
+    @property
+    def L(self) -> sp.Expr:
+        """The Lagrangian ``K − V`` (or the one given outright)."""
+        if self._l_override is not None:
+            return self._l_override
+        return self.K - self.V
+
+    @L.setter
+    def L(self, expr: Any) -> None:
+        self._l_override = sp.sympify(expr)
+
+    @property
+    def gravity_vector(self) -> sp.Matrix:
+        """Gravity acceleration vector (m/s²) in world coordinates."""
+        return self._g * self._g_dir
+
+    # ------------------------------------------------------------------ forces
+    def force(self, generalized: Any) -> None:
+        """Add a generalized force vector Γ (one entry per coordinate; may depend on q, q̇, t)."""
+        v = sp.Matrix(generalized)
+        if v.shape != (len(self.q), 1):
+            raise ModelError(
+                f"model {self.name!r}: generalized force needs {len(self.q)} entries, got {len(v)}"
+            )
+        self._forces.append(v)
+
+    def torque(self, tau: Any, angle: Any) -> None:
+        """A torque ``tau`` (N·m) doing work on ``angle`` (an expression of q, e.g. a joint angle).
+
+        By virtual work its generalized force is ``tau · ∂angle/∂q``: a hip torque between two
+        absolute leg angles is ``model.torque(tau, swing - stance)``.
+        """
+        angle = sp.sympify(angle)
+        self._forces.append(sp.Matrix([sp.sympify(tau) * sp.diff(angle, qi) for qi in self.q]))
+
+    def point_force(self, point: str, force: Any) -> None:
+        """A force (N, world frame) applied at a named point; Γ = Jᵀ F."""
+        if point not in self.points:
+            raise ModelError(f"model {self.name!r}: force on unknown point {point!r}")
+        f = sp.Matrix(force)
+        jac = self.points[point].jacobian(self.q)
+        self._forces.append(jac.T * f)
+
+    @property
+    def generalized_force(self) -> sp.Matrix:
+        """Γ(q, q̇, t): the sum of all declared forces (zeros if none)."""
+        out = sp.zeros(len(self.q), 1)
+        for f in self._forces:
+            out += f
+        return out
+
+    # ------------------------------------------------------------------ helpers
+    @property
+    def parameter_names(self) -> list[str]:
+        return [str(s) for s in self.params]
+
+    @property
+    def state_names(self) -> list[str]:
+        """State order: all coordinates, then all velocities."""
+        return [str(s) for s in self.q] + [str(s) for s in self.qd]
+
+    def symbol(self, name: str) -> sp.Symbol:
+        """Look up a coordinate, velocity or parameter symbol by name."""
+        for s in [*self.q, *self.qd, *self.params]:
+            if str(s) == name:
+                return s
+        raise ModelError(f"model {self.name!r}: no symbol named {name!r}")
+
+    def _down(self) -> sp.Matrix:
+        return sp.Matrix([0, -1]) if self.dims == 2 else sp.Matrix([0, 0, -1])
+
+    def _check_symbols(self, expr: Any, what: str) -> None:
+        allowed = set(self.q) | set(self.params) | {t}
+        free = sp.sympify(expr).free_symbols if not isinstance(expr, sp.MatrixBase) else expr.free_symbols
+        bad = sorted(str(s) for s in free - allowed)
+        if bad:
+            raise ModelError(
+                f"model {self.name!r}: {what} uses {', '.join(bad)}, which "
+                f"{'is' if len(bad) == 1 else 'are'} neither a coordinate nor a parameter"
+            )
+
+    def validate(self) -> None:
+        """Check the model is complete and physically sensible at the default parameters."""
+        if not self.q:
+            raise ModelError(f"model {self.name!r} has no coordinates")
+        defaults = {s: v for s, v in self.params.items()}
+        for name, m in self.masses.items():
+            try:
+                val = float(m.subs(defaults))
+            except TypeError:
+                raise ModelError(f"model {self.name!r}: mass at {name!r} is not a constant") from None
+            if not val > 0:
+                raise ModelError(
+                    f"model {self.name!r}: mass at point {name!r} must be positive, got {val:g}"
+                )
+        allowed_kv = set(self.q) | set(self.qd) | set(self.params) | {t}
+        for label, expr in (("K", self.K), ("V", self.V), ("L", self.L)):
+            bad = sorted(str(s) for s in expr.free_symbols - allowed_kv)
+            if bad:
+                raise ModelError(
+                    f"model {self.name!r}: {label} uses {', '.join(bad)}, which is neither a "
+                    "coordinate, a velocity nor a parameter"
+                )
+        if any(s in self.V.free_symbols for s in self.qd):
+            raise ModelError(f"model {self.name!r}: the potential energy V depends on velocities")
+        bad = sorted(str(s) for s in self.generalized_force.free_symbols - allowed_kv)
+        if bad:
+            raise ModelError(f"model {self.name!r}: forces use unknown symbols {', '.join(bad)}")
+
+    def _repr_latex_(self) -> str:
+        from .equations import derive
+
+        return derive(self).latex(display=True)
+
+    def __repr__(self) -> str:
+        return (
+            f"Model({self.name!r}, dims={self.dims}, q=[{', '.join(map(str, self.q))}], "
+            f"params=[{', '.join(self.parameter_names)}])"
+        )

@@ -1,0 +1,31 @@
+"""Compass gait: two straight legs and a hip mass on a slope (thesis Section 4.1, Table 2).
+
+Coordinates (Drake's convention, thesis Eq. 17–19)::
+
+            hip (m_H)            stance: angle of the stance leg from the vertical,
+            /  \\                         foot → hip, positive leaning downhill (+x)
+     a   m /    \\ m   b         swing:  angle of the swing leg from the vertical,
+          /      \\                       foot → hip, positive leaning downhill
+    stance foot   swing foot     both legs: mass m at distance b from the foot (a from the hip)
+
+State: ``stance, swing, stance_dot, swing_dot`` (rad, rad/s). The slope descends along +x at
+``slope`` rad; heel strike when the swing foot reaches it ahead of the stance foot, then the
+plastic impact (derived) and the swap of the legs. Parameters (Table 2): ``mh`` 10 kg, ``m`` 5 kg,
+``a`` = ``b`` = 0.5 m, ``g`` 9.81 m/s², ``slope`` 0.05 rad.
+"""
+
+from amble import Model, R, walker
+
+
+def build():
+    m = Model("compass-gait")
+    st, sw = m.coordinates("stance swing")
+    mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
+    m.point("stance_foot", (0, 0))
+    hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
+    m.point("stance_mass", b * R(st), mass=ml)
+    m.point("swing_mass", hip - a * R(sw), mass=ml)
+    m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
+    m.gravity(g)
+    return walker(m, foot="swing_foot", hip="hip", slope=slope, relabel={st: sw, sw: st},
+                  start=[-0.2168, 0.3168, 1.0839, 0.3981], doc=__doc__)

@@ -1,0 +1,201 @@
+"""The result of a simulation: samples, events, outcome — and views of it (energy, points, tables).
+
+Rows are samples in time order: the initial state, states on a fixed output grid (or at every
+integration step), and at each event the pre-event and post-event states at the same time.
+States of different modes have different lengths; rows are padded with NaN to the longest.
+Point positions are in the stance-foot frame of each step; :meth:`Trajectory.world_points`
+accumulates the footholds so a walk can be drawn on its slope.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .errors import AmbleError
+
+if TYPE_CHECKING:
+    from .kernels import Kernels
+
+
+@dataclass
+class Event:
+    """One transition: when, which, and the state just before and just after it."""
+
+    t: float
+    name: str
+    source: str
+    target: str
+    x_pre: np.ndarray
+    x_post: np.ndarray
+
+
+@dataclass
+class Trajectory:
+    """A simulated run. ``status`` is ``completed`` (all steps done), ``end_time``, ``fell``,
+    ``zeno``, ``integrator_failure``, ``singular_mass``, ``reset_failed`` or ``max_events``."""
+
+    t: np.ndarray
+    mode: np.ndarray
+    x: np.ndarray
+    events: list[Event]
+    status: str
+    message: str
+    steps: int
+    params: np.ndarray
+    kernels: Kernels
+    final_state: np.ndarray
+    final_mode: str
+    _world: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    # ------------------------------------------------------------------ basic views
+    @property
+    def mode_names(self) -> list[str]:
+        return list(self.kernels.meta["modes"])
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return dict(zip(self.kernels.meta["params"], self.params.tolist()))
+
+    def state_names(self, mode: str | None = None) -> list[str]:
+        return list(self.kernels.meta["state_names"][mode or self.mode_names[0]])
+
+    @property
+    def step_events(self) -> list[Event]:
+        """Events that are footfalls (transitions declared with ``step=True``)."""
+        steps = {tr["name"] for tr in self.kernels.meta["transitions"] if tr["step"]}
+        return [e for e in self.events if e.name in steps]
+
+    @property
+    def final_post_impact_state(self) -> np.ndarray | None:
+        """State just after the last footfall (the Poincaré section of a walker), if any."""
+        ev = self.step_events
+        return ev[-1].x_post.copy() if ev else None
+
+    def column(self, name: str) -> np.ndarray:
+        """Samples of one state variable by name (NaN in rows of modes that lack it)."""
+        out = np.full(len(self.t), np.nan)
+        for mi, mname in enumerate(self.mode_names):
+            names = self.state_names(mname)
+            if name in names:
+                rows = self.mode == mi
+                out[rows] = self.x[rows, names.index(name)]
+        if np.all(np.isnan(out)) and not any(name in self.state_names(m) for m in self.mode_names):
+            raise AmbleError(f"no state variable named {name!r}")
+        return out
+
+    def energy(self) -> np.ndarray:
+        """Kinetic and potential energy per row, shape (N, 2), in J."""
+        return self.kernels.energy_rows(self.t, self.mode, self.x, self.params)
+
+    def points(self) -> dict[str, np.ndarray]:
+        """Positions of named points per row in the current stance frame, (N, 3) each."""
+        pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
+        return {n: pos[:, i, :] for i, n in enumerate(self.kernels.meta["points"])}
+
+    def world_points(self) -> dict[str, np.ndarray]:
+        """Point positions in the world frame: each footfall moves the origin to the new foothold."""
+        if self._world is None:
+            pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
+            shifts = self._origin_per_row(pos)
+            self._world = {n: pos[:, i, :] + shifts for i, n in enumerate(self.kernels.meta["points"])}
+        return self._world
+
+    def _origin_per_row(self, pos: np.ndarray) -> np.ndarray:
+        meta = self.kernels.meta
+        shift_of = {tr["name"]: tr["shift"] for tr in meta["transitions"]}
+        pidx = {n: i for i, n in enumerate(meta["points"])}
+        origin = np.zeros(3)
+        out = np.zeros((len(self.t), 3))
+        ev_iter = iter(self.events)
+        ev = next(ev_iter, None)
+        i = 0
+        n = len(self.t)
+        while i < n:
+            out[i] = origin
+            # an event writes a pre row then a post row at the same time
+            if ev is not None and i + 1 < n and self.t[i] == ev.t and self.t[i + 1] == ev.t:
+                sp = shift_of.get(ev.name)
+                if sp is not None:
+                    origin = origin + pos[i, pidx[sp]]
+                ev = next(ev_iter, None)
+            i += 1
+        return out
+
+    # ------------------------------------------------------------------ resampling & export
+    def resample(self, fps: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """World point positions at a fixed frame rate (for animation): (times, points)."""
+        if fps <= 0:
+            raise AmbleError("frame rate must be positive")
+        wp = self.world_points()
+        times = np.arange(self.t[0], self.t[-1] + 1e-12, 1.0 / fps)
+        idx = np.searchsorted(self.t, times, side="right") - 1
+        idx = np.clip(idx, 0, len(self.t) - 1)
+        nxt = np.clip(idx + 1, 0, len(self.t) - 1)
+        dt = self.t[nxt] - self.t[idx]
+        same = (self.mode[nxt] == self.mode[idx]) & (dt > 0)
+        w = np.where(same, (times - self.t[idx]) / np.where(dt > 0, dt, 1.0), 0.0)
+        out = {}
+        for name, arr in wp.items():
+            a, b = arr[idx], arr[nxt]
+            interp = a + (b - a) * w[:, None]
+            out[name] = np.where(np.isfinite(interp), interp, a)
+        return times, out
+
+    def table(self) -> dict[str, np.ndarray]:
+        """Columns: ``t``, ``mode``, then every state variable of every mode (NaN where absent)."""
+        cols: dict[str, np.ndarray] = {"t": self.t, "mode": np.array([self.mode_names[m] for m in self.mode])}
+        for m in self.mode_names:
+            for name in self.state_names(m):
+                if name not in cols:
+                    cols[name] = self.column(name)
+        e = self.energy()
+        cols["kinetic_energy"], cols["potential_energy"] = e[:, 0], e[:, 1]
+        return cols
+
+    def save(self, path: str | Path) -> Path:
+        """Write the samples to ``.csv``, ``.parquet`` or ``.npz`` (chosen by suffix)."""
+        path = Path(path)
+        cols = self.table()
+        suffix = path.suffix.lower()
+        if suffix == ".npz":
+            ev = {
+                "event_t": np.array([e.t for e in self.events]),
+                "event_name": np.array([e.name for e in self.events]),
+            }
+            np.savez(path, **cols, **ev)
+        elif suffix == ".csv":
+            import csv
+
+            with path.open("w", newline="") as f:
+                wr = csv.writer(f)
+                wr.writerow(list(cols))
+                for row in zip(*cols.values()):
+                    wr.writerow([v if isinstance(v, str) else repr(float(v)) for v in row])
+        elif suffix == ".parquet":
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            pq.write_table(pa.table({k: pa.array(v) for k, v in cols.items()}), path)
+        else:
+            raise AmbleError(f"unknown output format {path.suffix!r}: use .csv, .parquet or .npz")
+        return path
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly summary of the run (the CLI's ``--json`` output)."""
+        post = self.final_post_impact_state
+        return {
+            "status": self.status,
+            "message": self.message,
+            "steps": self.steps,
+            "events": len(self.events),
+            "time": float(self.t[-1]) if len(self.t) else float("nan"),
+            "state_names": self.state_names(self.mode_names[0]),
+            "final_post_impact_state": None if post is None else post.tolist(),
+            "final_state": self.final_state.tolist(),
+            "final_mode": self.final_mode,
+            "parameters": self.parameters,
+        }

@@ -1,0 +1,69 @@
+"""Walkers on a slope: heel-strike guards, impact resets and falls from a few declarations.
+
+The walking surface is a plane through the stance foot (the origin of every step's frame)
+descending along ``+x`` at angle ``slope``. Its unit normal is ``n = (sin γ, cos γ)`` in 2D
+(``(sin γ, 0, cos γ)`` in 3D) and the downhill direction along it is ``d = (cos γ, −sin γ)``.
+A point's height above the ground is ``n·p``; it is ahead of the stance foot when ``d·p > 0``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import sympy as sp
+
+from .hybrid import Guard, HybridSystem, Impact
+from .model import Model
+
+
+def _vec2(model: Model, a: Any, b: Any) -> sp.Matrix:
+    return sp.Matrix([a, b]) if model.dims == 2 else sp.Matrix([a, 0, b])
+
+
+def height_above_slope(model: Model, point: str, slope: Any) -> sp.Expr:
+    """Height (m) of a named point above the slope plane through the origin, along its normal."""
+    n = _vec2(model, sp.sin(slope), sp.cos(slope))
+    return (n.T * model.points[point])[0, 0]
+
+
+def distance_along_slope(model: Model, point: str, slope: Any) -> sp.Expr:
+    """Distance (m) of a named point ahead of the origin, measured downhill along the slope."""
+    d = _vec2(model, sp.cos(slope), -sp.sin(slope))
+    return (d.T * model.points[point])[0, 0]
+
+
+def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any]) -> tuple[Guard, Impact]:
+    """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot,
+    followed by a plastic impact and the leg relabelling."""
+    guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > 0)
+    return guard, Impact(foot, relabel)
+
+
+def walker(
+    model: Model,
+    *,
+    foot: str,
+    hip: str,
+    slope: Any,
+    relabel: Mapping[Any, Any],
+    start: Sequence[float] | None = None,
+    guess: Sequence[float] | None = None,
+    max_step_time: float = 5.0,
+    doc: str = "",
+) -> HybridSystem:
+    """A one-mode walker: heel strike of ``foot`` on the slope (a step) and a fall of ``hip``.
+
+    ``start`` is the default initial state, ``guess`` the default fixed-point guess (both in
+    ``model.state_names`` order). A walker that makes no footfall for ``max_step_time`` seconds,
+    or whose hip reaches the ground, has fallen.
+    """
+    sys_ = HybridSystem(model.name, {model.name: model}, ground_slope=slope, hip=hip, doc=doc)
+    guard, reset = heel_strike(model, foot, slope, relabel)
+    sys_.transition("heel_strike", model.name, guard, reset, step=True)
+    sys_.terminal("hip_on_ground", model.name, Guard(height_above_slope(model, hip, slope), -1), status="fell")
+    if start is not None:
+        sys_.default_start[model.name] = list(start)
+    sys_.fixed_point_guess = list(guess) if guess is not None else (list(start) if start is not None else None)
+    sys_.max_step_time = max_step_time
+    return sys_
