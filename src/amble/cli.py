@@ -90,10 +90,10 @@ def _load(name: str):
 
 # ---------------------------------------------------------------------- commands
 def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
-    from .models import REGISTRY, load
+    from .models import load, names
 
     rows = []
-    for name in REGISTRY:
+    for name in names():
         s = load(name)
         first = s.mode_names[0]
         rows.append({"name": name, "dims": s.dims, "modes": s.mode_names, "state_names": s.state_names(first),

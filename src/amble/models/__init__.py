@@ -1,27 +1,37 @@
-"""The model library: each module defines ``build() -> HybridSystem`` with the public API only."""
+"""The model library: each module defines ``NAME`` and ``build() -> HybridSystem``, written with
+the public API only. Modules in this package are discovered automatically."""
 
 from __future__ import annotations
 
 import importlib
-from functools import cache, lru_cache
+import pkgutil
+from functools import lru_cache
 
 from ..errors import ModelError
 from ..hybrid import HybridSystem
 
-#: model name → module (in this package)
-REGISTRY: dict[str, str] = {
-    "compass-gait": "compass_gait",
-}
+
+@lru_cache(maxsize=1)
+def registry() -> dict[str, str]:
+    """Model name → module name, for every module of this package that defines ``NAME``."""
+    out: dict[str, str] = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        name = getattr(mod, "NAME", None)
+        if name:
+            out[name] = info.name
+    order = ["compass-gait", "kneed-biped", "humanoid-2d", "humanoid-3d", "simplest-walker", "rimless-wheel"]
+    return dict(sorted(out.items(), key=lambda kv: (order.index(kv[0]) if kv[0] in order else len(order), kv[0])))
 
 
 def names() -> list[str]:
-    return list(REGISTRY)
+    return list(registry())
 
 
-@cache
+@lru_cache(maxsize=None)
 def load(name: str) -> HybridSystem:
     """Build a model of the library by name (cached per process)."""
-    if name not in REGISTRY:
-        raise ModelError(f"unknown model {name!r}; available: {', '.join(REGISTRY)}")
-    mod = importlib.import_module(f"{__name__}.{REGISTRY[name]}")
-    return mod.build()
+    reg = registry()
+    if name not in reg:
+        raise ModelError(f"unknown model {name!r}; available: {', '.join(reg)}")
+    return importlib.import_module(f"{__name__}.{reg[name]}").build()

@@ -16,6 +16,8 @@ plastic impact (derived) and the swap of the legs. Parameters (Table 2): ``mh`` 
 
 from amble import Model, R, walker
 
+NAME = "compass-gait"
+
 
 def build():
     m = Model("compass-gait")
