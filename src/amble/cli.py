@@ -118,8 +118,8 @@ def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
             "coordinates": [str(q) for q in m.q],
             "velocities": [str(v) for v in m.qd],
             "parameters": {str(k): v for k, v in m.params.items()},
-            "mass_matrix": [[sp.sstr(eq.M[i, j]) for j in range(eq.M.cols)] for i in range(eq.M.rows)],
-            "bias": [sp.sstr(e) for e in eq.h],
+            "mass_matrix": [[_show(eq.M[i, j]) for j in range(eq.M.cols)] for i in range(eq.M.rows)],
+            "bias": [_show(e) for e in eq.h],
             "generalized_force": [sp.sstr(e) for e in eq.Gamma],
             "gravity_vector": [sp.sstr(e) for e in g],
             "operation_count": eq.count_ops(),
@@ -146,6 +146,16 @@ def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
         for tr in out["transitions"]:
             print(f"transition {tr['name']}: {tr['source']} -> {tr['target']} ({tr['reset'] or tr['terminal']})")
     return out
+
+
+def _show(expr: Any) -> str:
+    """A readable string of an entry: small ones are tidied with trigsimp (the compiled code
+    never is — derivation keeps expressions unexpanded), large ones are printed as derived."""
+    import sympy as sp
+
+    if sp.count_ops(expr) <= 150:
+        expr = sp.trigsimp(expr)
+    return sp.sstr(expr)
 
 
 def _start(s, text: str | None, params: dict[str, float]):
@@ -241,6 +251,10 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
+    for text in args.param:  # validate ranges before any work starts
+        parse_range(text)
+    if len(args.param) > 2:
+        raise UsageError("--param can be given once (1D sweep) or twice (2D map)")
     from .analysis.sweep import sweep_cli
 
     return sweep_cli(args)

@@ -1,0 +1,87 @@
+"""The command-line contract of DESIGN.md: JSON fields, exit codes, one-line errors."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+import sympy as sp
+
+from amble.cli import main
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_models_json(capsys):
+    code, out, _ = run(capsys, "models", "--json")
+    assert code == 0
+    names = [m["name"] for m in json.loads(out)["models"]]
+    assert "compass-gait" in names
+
+
+def test_simulate_json_contract(capsys, tmp_path):
+    code, out, _ = run(capsys, "simulate", "compass-gait", "--steps", "5", "--json", "--out", str(tmp_path / "w.csv"))
+    assert code == 0
+    d = json.loads(out)
+    assert d["status"] == "completed" and d["steps"] == 5 and d["events"] == 5
+    assert d["state_names"] == ["stance", "swing", "stance_dot", "swing_dot"]
+    assert len(d["final_post_impact_state"]) == 4
+    assert (tmp_path / "w.csv").exists()
+
+
+def test_limit_cycle_json_contract(capsys):
+    code, out, _ = run(capsys, "limit-cycle", "compass-gait", "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert {"state_names", "fixed_point", "step_time", "multipliers", "stable"} <= set(d)
+    assert d["stable"] is True and all(len(m) == 2 for m in d["multipliers"])
+
+
+def test_equations_json_parses_with_sympy(capsys):
+    code, out, _ = run(capsys, "equations", "compass-gait", "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert d["coordinates"] == ["stance", "swing"]
+    assert d["parameters"]["slope"] == 0.05
+    M = sp.Matrix([[sp.sympify(e) for e in row] for row in d["mass_matrix"]])
+    h = [sp.sympify(e) for e in d["bias"]]
+    names = {str(s) for s in M.free_symbols} | {str(s) for e in h for s in e.free_symbols}
+    assert names <= {"stance", "swing", "stance_dot", "swing_dot", "mh", "m", "a", "b", "g", "slope"}
+    assert "swing_dot" in names
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["simulate", "no-such-model"], "unknown model"),
+        (["simulate", "compass-gait", "--set", "nope=1"], "unknown parameter"),
+        (["simulate", "compass-gait", "--set", "slope"], "NAME=VALUE"),
+        (["simulate", "compass-gait", "--set", "slope=abc"], "not a number"),
+        (["simulate", "compass-gait", "--steps", "0"], "at least 1"),
+        (["simulate", "compass-gait", "--start", "x0=1,2"], "4"),
+        (["simulate", "compass-gait", "--out", "/nonexistent-dir/x.csv"], "does not exist"),
+        (["simulate", "compass-gait", "--out", "x.txt"], "must end with"),
+        (["sweep", "compass-gait", "--param", "slope=0.1:0.1:5"], "empty range"),
+        (["bogus-command"], "invalid choice"),
+    ],
+)
+def test_user_errors_exit_2_with_one_line(capsys, args, needle):
+    code, out, err = run(capsys, *args)
+    assert code == 2
+    assert err.startswith("amble: error:") and err.count("\n") == 1
+    assert needle in err
+
+
+def test_json_error_object(capsys):
+    code, out, _ = run(capsys, "simulate", "no-such-model", "--json")
+    assert code == 2
+    assert "unknown model" in json.loads(out)["error"]
+
+
+def test_console_script_help_has_an_example():
+    r = subprocess.run([sys.executable, "-m", "amble.cli", "simulate", "--help"], capture_output=True, text=True)
+    assert r.returncode == 0 and "example:" in r.stdout
