@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..errors import ConvergenceError, SimulationError, StateError
 from ..hybrid import HybridSystem
@@ -123,7 +122,7 @@ class ReturnMap:
             e = np.zeros(n_pre)
             e[j] = h
             grad[j] = (k.guards(src, t, xpre + e, self.p)[gi] - k.guards(src, t, xpre - e, self.p)[gi]) / (2 * h)
-        N = sla.null_space(grad[None, :])
+        N = np.linalg.svd(grad[None, :])[2][1:].T  # null space of the guard gradient
         DR = np.zeros((self.n, n_pre))
         for j in range(n_pre):
             e = np.zeros(n_pre)
@@ -137,8 +136,18 @@ class ReturnMap:
 
 def _chart(U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Coordinates that chart the tangent space best, and the map from their increments to states."""
-    _, _, piv = sla.qr(U.T, pivoting=True)
-    S = np.sort(piv[: U.shape[1]])
+    # pivoted Gram–Schmidt on the rows of U (= QR with column pivoting of Uᵀ): pick, one at a
+    # time, the state coordinate whose tangent row is least explained by those already picked
+    R = U.copy()
+    piv: list[int] = []
+    for _ in range(U.shape[1]):
+        norms = np.linalg.norm(R, axis=1)
+        norms[piv] = -1.0
+        j = int(np.argmax(norms))
+        piv.append(j)
+        v = R[j] / np.linalg.norm(R[j])
+        R = R - np.outer(R @ v, v)
+    S = np.sort(np.array(piv))
     E = U @ np.linalg.inv(U[S, :])  # n × d: increment of the chart coordinates → tangent vector
     return S, E
 
