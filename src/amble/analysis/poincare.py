@@ -196,9 +196,13 @@ def find_fixed_point(
     x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
-        y, _ = P(x)  # start on the section
+        return _newton(system, P, x, period, tol, max_iter)
     except SimulationError as e:
-        raise ConvergenceError(f"no fixed point: the guess does not walk ({e})") from None
+        raise ConvergenceError(f"no fixed point from this guess: {e}") from None
+
+
+def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int) -> LimitCycle:
+    y, _ = P(x)  # start on the section
     it = 0
     res = math.inf
     for it in range(1, max_iter + 1):
