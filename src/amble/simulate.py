@@ -216,7 +216,9 @@ def simulate(
                    zeno_events=base.zeno_events, max_events=base.max_events, nsub=base.nsub)
     st, ctx, rec = run(k, p, mi, x, t_end=t_end if t_end is not None else math.inf, steps=steps or 0,
                        opts=opts, sample_dt=sample_dt, record=True)
-    return _trajectory(k, p, st, ctx, rec, opts)
+    traj = _trajectory(k, p, st, ctx, rec, opts)
+    traj.system = system
+    return traj
 
 
 def _trajectory(k: Kernels, p: np.ndarray, st: int, ctx: np.ndarray, rec: dict, opts: Options) -> Trajectory:

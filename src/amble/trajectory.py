@@ -49,6 +49,7 @@ class Trajectory:
     kernels: Kernels
     final_state: np.ndarray
     final_mode: str
+    system: Any = field(default=None, repr=False)
     _world: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     # ------------------------------------------------------------------ basic views
@@ -183,6 +184,29 @@ class Trajectory:
         else:
             raise AmbleError(f"unknown output format {path.suffix!r}: use .csv, .parquet or .npz")
         return path
+
+    def animate(self, path: str | Path, fps: float = 60.0) -> Path:
+        """Write an animation: ``.html`` (interactive 3D, offline), ``.gif`` or ``.mp4``."""
+        from .viz.animate import animate
+
+        return animate(self.system, self, path, fps=fps)
+
+    def plot(self, path: str | Path | None = None, variables: list[str] | None = None) -> Any:
+        """Time series of the coordinates and the energies (a matplotlib figure, or a file)."""
+        from .viz.plot import plot_trajectory
+
+        return plot_trajectory(self, path, variables)
+
+    def _repr_html_(self) -> str:
+        """In Jupyter a trajectory shows itself as the interactive 3D viewer."""
+        import html as _html
+
+        from .viz.animate import scene_of
+        from .viz.html import render_html
+
+        page = render_html(scene_of(self.system, self, fps=30.0), title=f"amble — {self.kernels.meta['name']}")
+        return (f'<iframe srcdoc="{_html.escape(page)}" style="width:100%;height:480px;border:0" '
+                'sandbox="allow-scripts"></iframe>')
 
     def summary(self) -> dict[str, Any]:
         """JSON-friendly summary of the run (the CLI's ``--json`` output)."""

@@ -43,6 +43,29 @@ class LimitCycle:
     period: int
     parameters: dict[str, float]
     jacobian: np.ndarray = field(repr=False)
+    hybrid_system: Any = field(default=None, repr=False)
+
+    def trajectory(self, steps: int | None = None) -> Any:
+        """Simulate the gait from the fixed point (default: two periods), samples every 5 ms."""
+        return simulate(self.hybrid_system, self.fixed_point, params=self.parameters,
+                        steps=steps or 2 * self.period, sample_dt=0.005)
+
+    def plot(self, path: Any = None) -> Any:
+        """Phase portrait of the cycle with its impact jumps (thesis Figures 8, 10, 12)."""
+        from ..viz.plot import plot_limit_cycle
+
+        return plot_limit_cycle(self.trajectory(), path, cycle=self)
+
+    def _repr_png_(self) -> bytes:
+        import io
+
+        import matplotlib.pyplot as plt
+
+        fig = self.plot()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=90)
+        plt.close(fig)
+        return buf.getvalue()
 
     @property
     def stable(self) -> bool:
@@ -242,4 +265,4 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
     return LimitCycle(system=system.name, mode=P.mode, state_names=list(names), fixed_point=xs, step_time=T / period,
                       multipliers=mult, section_coordinates=[names[i] for i in S],
                       residual=float(np.max(np.abs(Px - xs))), iterations=it, period=period,
-                      parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A)
+                      parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A, hybrid_system=system)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -10,7 +11,7 @@ import numpy as np
 from ..errors import AmbleError
 from ..hybrid import HybridSystem
 from ..trajectory import Trajectory
-from .scene import Ground, default_look, frames
+from .scene import Ground, Sphere, default_look, frames
 
 
 def look_of(system: HybridSystem, params: dict[str, float]) -> list[Any]:
@@ -28,7 +29,15 @@ def look_of(system: HybridSystem, params: dict[str, float]) -> list[Any]:
         for name, mass in m.masses.items():
             masses[name] = max(masses.get(name, 0.0), float(mass.subs(subs)))
         links += [lk for lk in m.links if lk not in links]
-    return default_look(system.point_names, links, masses, slope=slope)
+    shapes = default_look(system.point_names, links, masses, slope=slope)
+    # Legs swap names at every footfall; colouring spheres by mass keeps a leg's colour fixed.
+    colours: dict[float, Any] = {}
+    out = []
+    for s in shapes:
+        if isinstance(s, Sphere) and masses.get(s.at, 0.0) > 0:
+            s = replace(s, color=colours.setdefault(round(masses[s.at], 9), s.color))
+        out.append(s)
+    return out
 
 
 def _slope(system: HybridSystem, params: dict[str, float]) -> float:
