@@ -62,6 +62,8 @@ def parse_range(text: str) -> tuple[str, float, float, int]:
         raise UsageError(f"range count must be at least 1, got {count}")
     if count > 1 and start == stop:
         raise UsageError(f"empty range {start}:{stop} with {count} points")
+    if start > stop:
+        raise UsageError(f"reversed range {start}:{stop}: give START below STOP")
     return name.strip(), start, stop, count
 
 
