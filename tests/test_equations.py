@@ -108,3 +108,18 @@ def test_piecewise_force_and_latex():
     assert eq.Gamma[0].subs({q: 1.0, k: 2.0}) == -2.0
     assert eq.Gamma[0].subs({q: -1.0, k: 2.0}) == 0
     assert "\\ddot" in eq.latex()
+
+
+def test_body_inertia_of_a_3d_body():
+    # A body turning about z by q then tilting about its x axis by r (R = Rz(q) Rx(r)), principal
+    # inertias (A, B, C): by hand ω_body = (ṙ, q̇ sin r, q̇ cos r), so
+    # K = ½ (A ṙ² + B q̇² sin² r + C q̇² cos² r) and M = diag(B sin² r + C cos² r, A).
+    m = Model("top", dims=3)
+    q, r = m.coordinates("q r")
+    A, B, C = m.parameters(A=1.0, B=2.0, C=3.0)
+    Rz = sp.Matrix([[sp.cos(q), -sp.sin(q), 0], [sp.sin(q), sp.cos(q), 0], [0, 0, 1]])
+    Rx = sp.Matrix([[1, 0, 0], [0, sp.cos(r), -sp.sin(r)], [0, sp.sin(r), sp.cos(r)]])
+    m.body_inertia(Rz * Rx, sp.diag(A, B, C))
+    eq = derive(m)
+    expected = sp.Matrix([[B * sp.sin(r) ** 2 + C * sp.cos(r) ** 2, 0], [0, A]])
+    assert sp.simplify(eq.M - expected) == sp.zeros(2, 2)

@@ -68,3 +68,51 @@ def test_impact_conserves_angular_momentum_and_never_adds_energy(compass):
         e0 = k.energy_rows([0.0], [0], x, p)[0, 0]
         e1 = k.energy_rows([0.0], [0], post, p)[0, 0]
         assert e1 <= e0 * (1 + 1e-12)
+
+
+def test_thesis_reset_written_explicitly_equals_the_derived_impact(compass):
+    """The thesis' J(q) (Eq. 21) and H_g = Q₊⁻¹Q₋ (Eq. 22, Goswami's angular-momentum matrices)
+    written as an Explicit reset give the same post-impact states as the derived Impact."""
+    import sympy as sp
+
+    from amble import Explicit, HybridSystem
+
+    m = compass.modes["compass-gait"]
+    st, sw = m.q
+    std, swd = m.qd
+    mh, ml, a, b = (m.symbol(n) for n in ("mh", "m", "a", "b"))
+    l = a + b
+    ga, gb = b, a  # Goswami's a (foot→mass) and b (mass→hip) in the thesis' naming
+    c2 = sp.cos(sw - st)
+    Qm = sp.Matrix([[-ml * ga * gb, -ml * ga * gb + (mh * l**2 + 2 * ml * ga * l) * c2], [0, -ml * ga * gb]])
+    Qp = sp.Matrix([[ml * gb * (gb - l * c2), ml * l * (l - gb * c2) + ml * ga**2 + mh * l**2],
+                    [ml * gb**2, -ml * gb * l * c2]])
+    J = sp.Matrix([[0, 1], [1, 0]])
+    Hg = J * Qp.inv() * Qm * J  # in (stance, swing) order on both sides
+    explicit = HybridSystem("cg-explicit", {"compass-gait": m})
+    explicit.transition("heel_strike", "compass-gait", compass.transitions[0].guard,
+                        Explicit(q=J * sp.Matrix([st, sw]), qd=Hg * sp.Matrix([std, swd])), step=True)
+    k1, k2 = build(compass), build(explicit)
+    p = parameter_vector(k1, {"a": 0.45, "b": 0.55})
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        x = np.concatenate([rng.uniform(-0.5, 0.5, 2), rng.uniform(-2, 2, 2)])
+        assert np.allclose(k1.reset("heel_strike", 0, x, p)[1], k2.reset("heel_strike", 0, x, p)[1],
+                           rtol=1e-12, atol=1e-12)
+
+
+def test_dynamics_kernel_matches_the_symbolic_equations(compass):
+    from amble import derive
+
+    m = compass.modes["compass-gait"]
+    eq = derive(m)
+    k = build(compass)
+    p = parameter_vector(k, None)
+    x = np.array([0.1, -0.2, 0.7, -1.3])
+    M, h, G = k.dynamics(0, 0.0, x, p)
+    subs = dict(zip([*m.q, *m.qd], x)) | {s: v for s, v in zip(m.params, p)}
+    assert np.allclose(M, np.array(eq.M.subs(subs), dtype=float), rtol=1e-13)
+    assert np.allclose(h, np.array(eq.h.subs(subs), dtype=float).ravel(), rtol=1e-13)
+    assert np.allclose(G, 0.0)
+    qdd = k.rhs(0, 0.0, x, p)[2:]
+    assert np.allclose(M @ qdd + h, G, atol=1e-12)

@@ -149,6 +149,14 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         w(f"    int err = amble_chol_solve({n}, M, f);\n")
         w(f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n")
         w("    return err;\n}\n")
+        # M, h and Γ separately (analysis and display; the integrator uses rhs above)
+        tg = [f"M[{i * n + j}]" for i in range(n) for j in range(n)] + [f"h[{i}]" for i in range(n)]
+        tg += [f"G[{i}]" for i in range(n)]
+        ex = [eq.M[i, j] for i in range(n) for j in range(n)] + list(eq.h) + list(eq.Gamma)
+        w(f"static void dynamics_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n")
+        w("    (void)t; (void)p;\n")
+        w(_block(tg, ex, nm))
+        w("}\n")
         # guards of this mode's transitions
         trs = trs_by_mode[name]
         w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")
@@ -223,6 +231,8 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
              "guards_{}(t, x, p, g)", mode_list, "mode")
     dispatch("guards_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g)",
              "void", "guards_dot_{}(t, x, dx, p, g)", mode_list, "mode")
+    dispatch("dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G)",
+             "void", "dynamics_{}(t, x, p, M, h, G)", mode_list, "mode")
     dispatch("energy(int mode, double t, const double *x, const double *p, double *out)", "void",
              "energy_{}(t, x, p, out)", mode_list, "mode")
     dispatch("kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel)",

@@ -157,6 +157,7 @@ class Kernels:
         lib.amble_guards.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         lib.amble_reset.restype = ctypes.c_int
         lib.amble_reset.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _iptr]
+        lib.amble_dynamics.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr, _dptr]
         lib.amble_rows_energy.argtypes = [ctypes.c_long, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_long, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
         self.simulate_raw = lib.amble_simulate
@@ -178,6 +179,16 @@ class Kernels:
         if err:
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         return dx
+
+    def dynamics(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
+        mi = self.mode_index(mode)
+        nx = self.meta["nx"][mi]
+        x = _vec(x, nx)
+        n = nx // 2
+        M, h, G = np.zeros((n, n)), np.zeros(n), np.zeros(n)
+        self._lib.amble_dynamics(mi, float(t), _p(x), _p(p), _p(M), _p(h), _p(G))
+        return M, h, G
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         mi = self.mode_index(mode)

@@ -185,6 +185,21 @@ class Model:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
         self._k_terms.append(sp.Rational(1, 2) * sp.sympify(moment) * self.dt(angle) ** 2)
 
+    def body_inertia(self, rotation: Any, inertia: Any) -> None:
+        """Rotational inertia of a 3D body with orientation ``rotation`` (3×3, body → world).
+
+        Adds ``½ ωᵀ I ω`` with the body angular velocity ``ω`` from ``[ω]ₓ = Rᵀ Ṙ`` and the
+        inertia tensor ``I`` (kg·m², body axes, about the body's centre of mass — whose mass is
+        declared with :meth:`point`).
+        """
+        Rm = sp.Matrix(rotation)
+        Im = sp.Matrix(inertia)
+        if Rm.shape != (3, 3) or Im.shape != (3, 3):
+            raise ModelError(f"model {self.name!r}: body_inertia needs a 3×3 rotation and a 3×3 inertia")
+        W = Rm.T * self.dt(Rm)
+        w = sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
+        self._k_terms.append(sp.Rational(1, 2) * (w.T * Im * w)[0, 0])
+
     # ------------------------------------------------------------------ energies
     def gravity(self, g: Any, direction: Any = None) -> None:
         """Uniform gravity of magnitude ``g`` (m/s²) along ``direction`` (default: down, -z)."""

@@ -12,6 +12,7 @@
  *   void guards_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g);
  *   int enabled(int tr, double t, const double *x, const double *p);
  *   int reset(int tr, double t, const double *x, const double *p, double *xout, int *target);
+ *   void dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G);
  *   void energy(int mode, double t, const double *x, const double *p, double *out);
  *   void kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel);
  *
@@ -506,6 +507,10 @@ void amble_guards(int mode, double t, const double *x, const double *p, double *
 
 int amble_reset(int tr, double t, const double *x, const double *p, double *xout, int *target) {
     return reset(tr, t, x, p, xout, target);
+}
+
+void amble_dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G) {
+    dynamics(mode, t, x, p, M, h, G);
 }
 
 void amble_rows_energy(long nrows, const double *t, const int *mode, const double *x, const double *p, double *out) {
