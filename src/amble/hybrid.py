@@ -145,7 +145,7 @@ class HybridSystem:
         dims = {m.dims for m in self.modes.values()}
         if len(dims) != 1:
             raise ModelError(f"system {self.name!r}: modes mix 2D and 3D models")
-        self.parameters  # validates consistent defaults
+        _ = self.parameters  # validates consistent defaults
 
     # ------------------------------------------------------------------ declaring
     def transition(
@@ -267,7 +267,8 @@ def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
         _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
     elif isinstance(reset, Explicit):
         exprs = target_exprs(dst, reset.q, what) + target_exprs(dst, reset.qd, what, velocities=True)
-        _check_free(exprs, set(src.q) | set(src.qd) | set(src.params) | {sp.Symbol("t", real=True)}, what, "source state")
+        allowed = set(src.q) | set(src.qd) | set(src.params) | {sp.Symbol("t", real=True)}
+        _check_free(exprs, allowed, what, "source state")
         if reset.shift is not None and reset.shift not in src.points:
             raise ModelError(f"{what}: shift point {reset.shift!r} is not a point of mode {src.name!r}")
     else:

@@ -120,7 +120,8 @@ def _compile(src: str, so: Path, d: Path) -> None:
         c_file = Path(tmpd) / "model.c"
         c_file.write_text(src)
         out = Path(tmpd) / "model.so"
-        cmd = [*cc.split(), *flags, "-std=c99", "-fPIC", "-shared", "-I", str(_C_DIR), str(c_file), "-o", str(out), "-lm"]
+        cmd = [*cc.split(), *flags, "-std=c99", "-fPIC", "-shared", "-I", str(_C_DIR), str(c_file),
+               "-o", str(out), "-lm"]
         try:
             r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         except (OSError, subprocess.TimeoutExpired) as e:
@@ -180,7 +181,8 @@ class Kernels:
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         return dx
 
-    def dynamics(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def dynamics(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = self.mode_index(mode)
         nx = self.meta["nx"][mi]
@@ -218,7 +220,8 @@ class Kernels:
         self._lib.amble_rows_energy(len(t), _p(t), modes.ctypes.data_as(_iptr), _p(x), _p(p), _p(out))
         return out
 
-    def kinematics_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def kinematics_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray]:
         t, modes, x = _rows(t, modes, x, self.nx_max)
         pos = np.zeros((len(t), self.n_points, 3))
         vel = np.zeros((len(t), self.n_points, 3))

@@ -73,7 +73,8 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None) -> np.ndarr
     return p
 
 
-def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, mode: str | None) -> tuple[int, np.ndarray]:
+def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, mode: str | None
+                  ) -> tuple[int, np.ndarray]:
     mode = mode or k.meta["modes"][0]
     mi = k.mode_index(mode)
     names = k.meta["state_names"][mode]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-from functools import lru_cache
+from functools import cache, lru_cache
 
 from ..errors import ModelError
 from ..hybrid import HybridSystem
@@ -21,14 +21,15 @@ def registry() -> dict[str, str]:
         if name:
             out[name] = info.name
     order = ["compass-gait", "kneed-biped", "humanoid-2d", "humanoid-3d", "simplest-walker", "rimless-wheel"]
-    return dict(sorted(out.items(), key=lambda kv: (order.index(kv[0]) if kv[0] in order else len(order), kv[0])))
+    rank = {n: i for i, n in enumerate(order)}
+    return dict(sorted(out.items(), key=lambda kv: (rank.get(kv[0], len(order)), kv[0])))
 
 
 def names() -> list[str]:
     return list(registry())
 
 
-@lru_cache(maxsize=None)
+@cache
 def load(name: str) -> HybridSystem:
     """Build a model of the library by name (cached per process)."""
     reg = registry()
