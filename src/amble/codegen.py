@@ -259,6 +259,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
                 "terminal": tr.terminal,
                 "step": tr.step,
                 "shift": (tr.reset.shift_point if tr.reset is not None else None),
+                "mirror": getattr(tr.reset, "mirror", None),
             }
             for tr in order
         ],

@@ -71,6 +71,9 @@ class Impact(Reset):
 
     point: str
     relabel: Mapping[Any, Any]
+    #: ``"y"`` when the relabelling mirrors the lateral axis (a 3D walker whose left and right
+    #: legs swap roles); drawing code then reflects the world frame at every such footfall.
+    mirror: str | None = None
 
     @property
     def shift_point(self) -> str:  # type: ignore[override]

@@ -98,33 +98,35 @@ class Trajectory:
         return {n: pos[:, i, :] for i, n in enumerate(self.kernels.meta["points"])}
 
     def world_points(self) -> dict[str, np.ndarray]:
-        """Point positions in the world frame: each footfall moves the origin to the new foothold."""
+        """Point positions in the world frame: each footfall moves the origin to the new foothold
+        (and reflects the lateral axis when the impact's relabelling mirrors it)."""
         if self._world is None:
             pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
-            shifts = self._origin_per_row(pos)
-            self._world = {n: pos[:, i, :] + shifts for i, n in enumerate(self.kernels.meta["points"])}
+            origins, frames = self._frames_per_row(pos)
+            world = np.einsum("rij,rpj->rpi", frames, pos) + origins[:, None, :]
+            self._world = {n: world[:, i, :] for i, n in enumerate(self.kernels.meta["points"])}
         return self._world
 
-    def _origin_per_row(self, pos: np.ndarray) -> np.ndarray:
+    def _frames_per_row(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         meta = self.kernels.meta
-        shift_of = {tr["name"]: tr["shift"] for tr in meta["transitions"]}
+        info = {tr["name"]: tr for tr in meta["transitions"]}
         pidx = {n: i for i, n in enumerate(meta["points"])}
-        origin = np.zeros(3)
-        out = np.zeros((len(self.t), 3))
+        origin, frame = np.zeros(3), np.eye(3)
+        origins, frames = np.zeros((len(self.t), 3)), np.zeros((len(self.t), 3, 3))
         ev_iter = iter(self.events)
         ev = next(ev_iter, None)
-        i = 0
         n = len(self.t)
-        while i < n:
-            out[i] = origin
+        for i in range(n):
+            origins[i], frames[i] = origin, frame
             # an event writes a pre row then a post row at the same time
             if ev is not None and i + 1 < n and self.t[i] == ev.t and self.t[i + 1] == ev.t:
-                sp = shift_of.get(ev.name)
-                if sp is not None:
-                    origin = origin + pos[i, pidx[sp]]
+                tr = info.get(ev.name, {})
+                if tr.get("shift") is not None:
+                    origin = origin + frame @ pos[i, pidx[tr["shift"]]]
+                if tr.get("mirror") == "y":
+                    frame = frame @ np.diag([1.0, -1.0, 1.0])
                 ev = next(ev_iter, None)
-            i += 1
-        return out
+        return origins, frames
 
     # ------------------------------------------------------------------ resampling & export
     def resample(self, fps: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
