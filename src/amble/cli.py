@@ -293,7 +293,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     add("models", "list the model library").set_defaults(func=cmd_models)
     e = add("equations", "show the derived equations of motion and transitions of a model")
-    e.add_argument("model")
+    e.add_argument("model", help="model name (see 'amble models')")
     e.add_argument("--latex", action="store_true", help="LaTeX instead of plain text")
     e.set_defaults(func=cmd_equations)
     s = add("simulate", "simulate a model for N steps or T seconds")

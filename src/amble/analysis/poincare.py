@@ -220,8 +220,26 @@ def find_fixed_point(
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
         return _newton(system, P, x, period, tol, max_iter)
-    except SimulationError as e:
-        raise ConvergenceError(f"no fixed point from this guess: {e}") from None
+    except (SimulationError, ConvergenceError) as e:
+        if guess is not None or not params:
+            raise ConvergenceError(f"no fixed point from this guess: {e}") from None
+    # The model's own guess lies on the cycle at its default parameters: follow the cycle from
+    # there to the requested parameters in a few continuation stages.
+    defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
+    target = dict(zip(P.k.meta["params"], P.p.tolist()))
+    x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
+    stages = 8
+    for i in range(1, stages + 1):
+        s = i / stages
+        stage = {k: defaults[k] + s * (target[k] - defaults[k]) for k in target}
+        try:
+            lc = find_fixed_point(system, x, params=stage, period=period, rtol=rtol, atol=atol, tol=tol,
+                                  max_iter=max_iter)
+        except ConvergenceError as e:
+            raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
+                                   f"{i}/{stages} of the way ({e})") from None
+        x = lc.fixed_point
+    return lc
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int) -> LimitCycle:
