@@ -120,8 +120,8 @@ def _compile(src: str, so: Path, d: Path) -> None:
         c_file = Path(tmpd) / "model.c"
         c_file.write_text(src)
         out = Path(tmpd) / "model.so"
-        cmd = [*cc.split(), *flags, "-std=c99", "-Werror=implicit-function-declaration", "-fPIC", "-shared", "-I", str(_C_DIR), str(c_file),
-               "-o", str(out), "-lm"]
+        cmd = [*cc.split(), *flags, "-std=c99", "-Werror=implicit-function-declaration", "-fPIC", "-shared",
+               "-I", str(_C_DIR), str(c_file), "-o", str(out), "-lm"]
         try:
             r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         except (OSError, subprocess.TimeoutExpired) as e:
