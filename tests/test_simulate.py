@@ -118,3 +118,20 @@ def test_singular_mass_matrix_is_reported():
     sys_ = HybridSystem("degenerate", m)
     tr = amble.simulate(sys_, [0, 0, 1, 0], t_end=1.0)
     assert tr.status == "singular_mass"
+
+
+def test_changing_a_default_is_seen_without_recompiling():
+    from amble.kernels import build
+
+    def system(g):
+        m = _falling_mass()
+        m.params[m.symbol("g")] = g
+        sys_ = HybridSystem("falling-default", m)
+        sys_.terminal("landed", "falling-mass", Guard(m.q[1], -1), status="landed")
+        return sys_
+
+    a, b = system(9.81), system(1.62)
+    assert build(a).path == build(b).path  # one compiled library...
+    ta = amble.simulate(a, [0.0, 1.0, 0.0, 0.0], t_end=5.0).events[-1].t
+    tb = amble.simulate(b, [0.0, 1.0, 0.0, 0.0], t_end=5.0).events[-1].t
+    assert abs(ta - math.sqrt(2 / 9.81)) < 1e-10 and abs(tb - math.sqrt(2 / 1.62)) < 1e-10  # ...own defaults

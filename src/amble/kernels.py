@@ -12,6 +12,7 @@ The cache lives in ``$AMBLE_CACHE_DIR`` or ``~/.cache/amble``. ``$CC`` picks the
 
 from __future__ import annotations
 
+import copy
 import ctypes
 import hashlib
 import json
@@ -96,7 +97,7 @@ def build(system: HybridSystem) -> Kernels:
     """Compiled kernels of a system, from the in-process cache, the disk cache, or a fresh build."""
     key = structure_key(system)
     if key in _LOADED:
-        return _LOADED[key]
+        return _with_defaults(_LOADED[key], system)
     d = cache_dir()
     so, meta_f = d / f"{system.name}-{key}.so", d / f"{system.name}-{key}.json"
     if not (so.exists() and meta_f.exists()):
@@ -110,7 +111,18 @@ def build(system: HybridSystem) -> Kernels:
     meta = json.loads(meta_f.read_text())
     k = Kernels(so, meta)
     _LOADED[key] = k
-    return k
+    return _with_defaults(k, system)
+
+
+def _with_defaults(k: Kernels, system: HybridSystem) -> Kernels:
+    """Parameter defaults are not part of the structure (they compile to nothing): take them from
+    the system at hand, so two systems that differ only in defaults share one library."""
+    defaults = [float(system.parameters[p]) for p in k.meta["params"]]
+    if defaults == k.meta["param_defaults"]:
+        return k
+    view = copy.copy(k)
+    view.meta = {**k.meta, "param_defaults": defaults}
+    return view
 
 
 def _compile(src: str, so: Path, d: Path) -> None:
