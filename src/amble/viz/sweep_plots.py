@@ -1,0 +1,211 @@
+"""Plots of parameter sweeps (matplotlib, Agg backend): bifurcation diagram, fixed-point branch
+with multiplier moduli, two-parameter stability map, basin of attraction, Poincaré iterates.
+
+Every function writes one figure to ``path`` (format from the suffix: .png, .svg or .pdf) and
+returns the path. Angles are in rad, angular velocities in rad/s; a swept parameter's unit is
+taken from :data:`UNITS` when known (``slope`` rad, masses kg, lengths m, ``g`` m/s²).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+UNITS = {"slope": "rad", "mh": "kg", "m": "kg", "a": "m", "b": "m", "g": "m/s²", "l": "m", "r": "m"}
+_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _label(name: str) -> str:
+    unit = UNITS.get(name)
+    if unit is None:
+        unit = "rad/s" if name.endswith("_dot") else ("rad" if name in ("stance", "swing", "theta", "phi") else "")
+    return f"{name} ({unit})" if unit else name
+
+
+def _save(fig: Any, path: str | os.PathLike) -> Path:
+    p = Path(path)
+    if p.suffix.lower() not in _SUFFIXES:
+        from ..errors import StateError
+
+        raise StateError(f"plot file {str(p)!r} must end with one of {', '.join(_SUFFIXES)}")
+    fig.savefig(p, dpi=120, bbox_inches="tight")
+    _plt().close(fig)
+    return p
+
+
+def plot_bifurcation(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
+    """Post-transient iterates of the kept coordinate vs the swept parameter (one dot each);
+    values where the walker fell are marked below the axis."""
+    plt = _plt()
+    pname = result.params[0]
+    xs, ys, fell = [], [], []
+    coord = "state"
+    for r in result.rows:
+        v = float(r[pname])
+        coord = r.get("coordinate") or coord
+        if r["status"] != "ok":
+            fell.append(v)
+            continue
+        it = json.loads(r["iterates"])
+        xs.extend([v] * len(it))
+        ys.extend(it)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot(xs, ys, ".", ms=1.0 if len(xs) > 5000 else 2.0, color="k", lw=0)
+    if fell:
+        ax.plot(fell, [ax.get_ylim()[0]] * len(fell) if ys else [0] * len(fell), "x", color="tab:red", ms=4,
+                label="fell / failed")
+        ax.legend(loc="best", fontsize=8)
+    ax.set_xlabel(_label(pname))
+    ax.set_ylabel(f"post-impact {_label(coord)}")
+    ax.set_title(title or "Bifurcation diagram (post-transient return-map iterates)")
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_branch(result: Any, path: str | os.PathLike, *, coordinate: str | None = None,
+                title: str | None = None) -> Path:
+    """Fixed-point branch: one coordinate of the fixed point (top) and the moduli of the Floquet
+    multipliers (bottom, log scale, |λ| = 1 dashed) vs the parameter; stable points filled,
+    unstable hollow, failed points marked ×."""
+    plt = _plt()
+    pname = result.params[0]
+    coord = coordinate or (result.state_names[0] if result.state_names else None)
+    ok = [r for r in result.rows if r["status"] == "ok"]
+    bad = [float(r[pname]) for r in result.rows if r["status"] != "ok"]
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for stable, style in ((True, dict(mfc="tab:blue")), (False, dict(mfc="white"))):
+        rs = [r for r in ok if (r["stable"] == "true") == stable]
+        if not rs:
+            continue
+        v = [float(r[pname]) for r in rs]
+        lab = "stable" if stable else "unstable"
+        if coord is not None:
+            a1.plot(v, [float(r[f"x_{coord}"]) for r in rs], "o", ms=4, mec="tab:blue", label=lab, **style)
+        for r, x in zip(rs, v):
+            mods = json.loads(r["moduli"])
+            a2.plot([x] * len(mods), mods, "o", ms=3, mec="tab:purple", **({"mfc": "tab:purple"} if stable
+                                                                            else {"mfc": "white"}))
+    a2.plot([], [], "o", ms=3, mec="tab:purple", mfc="tab:purple", label="|λ|, stable gait")
+    a2.plot([], [], "o", ms=3, mec="tab:purple", mfc="white", label="|λ|, unstable gait")
+    a2.axhline(1.0, ls="--", color="k", lw=1)
+    a2.set_yscale("log")
+    if bad:
+        a1.plot(bad, [np.nan] * len(bad), "x")
+        for x in bad:
+            a2.axvline(x, color="tab:red", alpha=0.25, lw=1)
+        a2.plot([], [], color="tab:red", alpha=0.4, label="no fixed point")
+    a1.set_ylabel(f"fixed point {_label(coord)}" if coord else "fixed point")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    a2.set_ylabel("multiplier modulus |λ| (1)")
+    a2.set_xlabel(_label(pname))
+    a2.legend(fontsize=8)
+    a2.grid(alpha=0.3, which="both")
+    a1.set_title(title or "Fixed-point branch and Floquet multipliers")
+    return _save(fig, path)
+
+
+def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
+    """Two-parameter map of the largest multiplier modulus (colour, log scale), the |λ| = 1
+    contour, and grey cells where no fixed point was found."""
+    plt = _plt()
+    from matplotlib.colors import LogNorm
+
+    a, b = result.params
+    ni = max(int(r["i"]) for r in result.rows) + 1
+    nj = max(int(r["j"]) for r in result.rows) + 1
+    M = np.full((ni, nj), np.nan)
+    av, bv = np.full(ni, np.nan), np.full(nj, np.nan)
+    for r in result.rows:
+        i, j = int(r["i"]), int(r["j"])
+        av[i], bv[j] = float(r[a]), float(r[b])
+        if r["status"] == "ok":
+            M[i, j] = float(r["max_modulus"])
+    fig, ax = plt.subplots(figsize=(6.5, 5))
+    ax.set_facecolor("0.85")
+    ext = [bv.min(), bv.max(), av.min(), av.max()]
+    im = ax.imshow(M, origin="lower", aspect="auto", extent=ext, cmap="viridis",
+                   norm=LogNorm(vmin=np.nanmin(M) if np.isfinite(M).any() else 0.1,
+                                vmax=max(np.nanmax(M), 1.01) if np.isfinite(M).any() else 10))
+    if ni > 1 and nj > 1 and np.isfinite(M).any():
+        ax.contour(bv, av, M, levels=[1.0], colors="w", linewidths=1.5)
+    fig.colorbar(im, ax=ax, label="largest multiplier modulus |λ| (1)")
+    ax.set_xlabel(_label(b))
+    ax.set_ylabel(_label(a))
+    ax.set_title(title or "Stability map (white: |λ| = 1; grey: no fixed point)")
+    return _save(fig, path)
+
+
+BASIN_COLOURS = ("#2a9d8f", "#e76f51", "#e9c46a", "#6c757d")
+
+
+def plot_basin(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
+    """Basin map: categorical colours per outcome, legend, fixed point marked with a star."""
+    plt = _plt()
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    a, b = result.names
+    labels = list(result.labels)
+    cmap = ListedColormap(list(BASIN_COLOURS[: len(labels)]))
+    cmap.set_under("white")
+    norm = BoundaryNorm(np.arange(-0.5, len(labels) + 0.5), cmap.N)
+    fig, ax = plt.subplots(figsize=(6.5, 5))
+    av, bv = result.a_values, result.b_values
+    ext = [bv[0], bv[-1], av[0], av[-1]]
+    ax.imshow(np.ma.masked_less(result.outcome, 0), origin="lower", aspect="auto", extent=ext, cmap=cmap,
+              norm=norm, interpolation="nearest")
+    names = list(getattr(result, "state_names", []) or [])
+    fp = result.fixed_point
+    if names and a in names and b in names:
+        ax.plot(fp[names.index(b)], fp[names.index(a)], "*", color="k", ms=12, label="fixed point")
+    counts = result.counts()
+    handles = [Patch(color=cmap(c), label=f"{lab} ({counts[lab]})") for c, lab in enumerate(labels)]
+    ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.9)
+    ax.set_xlabel(f"initial post-impact {_label(b)}")
+    ax.set_ylabel(f"initial post-impact {_label(a)}")
+    ax.set_title(title or "Basin of attraction of the period-1 gait")
+    return _save(fig, path)
+
+
+def plot_poincare(iterates: np.ndarray, path: str | os.PathLike, *, state_names: list[str] | None = None,
+                  coordinates: tuple[int, int] = (0, 2), title: str | None = None) -> Path:
+    """Poincaré-map iterates: left, ``x_{k+1}`` vs ``x_k`` of the first chosen coordinate with the
+    diagonal (fixed points lie on it); right, the iterates in the plane of two coordinates,
+    coloured by step number."""
+    plt = _plt()
+    X = np.asarray(iterates, float)
+    names = state_names or [f"x{i}" for i in range(X.shape[1])]
+    c0, c1 = coordinates
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4.5))
+    u = X[:, c0]
+    a1.plot(u[:-1], u[1:], ".", ms=3, color="k")
+    lo, hi = (float(np.min(u)), float(np.max(u))) if u.size else (0.0, 1.0)
+    a1.plot([lo, hi], [lo, hi], "--", color="0.5", lw=1, label="x_{k+1} = x_k")
+    a1.set_xlabel(f"{_label(names[c0])} at footfall k")
+    a1.set_ylabel(f"{_label(names[c0])} at footfall k+1")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    sc = a2.scatter(X[:, c0], X[:, c1], c=np.arange(len(X)), s=6, cmap="plasma")
+    fig.colorbar(sc, ax=a2, label="footfall k (1)")
+    a2.set_xlabel(_label(names[c0]))
+    a2.set_ylabel(_label(names[c1]))
+    a2.grid(alpha=0.3)
+    fig.suptitle(title or "Poincaré-map iterates (post-impact states)")
+    return _save(fig, path)
+
+
+__all__ = ["plot_basin", "plot_bifurcation", "plot_branch", "plot_parameter_map", "plot_poincare"]

@@ -1,0 +1,184 @@
+"""Parameter sweeps: continuation, period doubling, resumable result files, failures, basins, CLI.
+
+Truth used here: the return-map fixed-point property P(x*) = x* checked by an independent
+simulation, the compass gait's post-impact section constraint stance + swing = 2·slope (both
+feet on the slope), the range where the compass gait's first period doubling is expected (a
+real multiplier flips through −1 between slope 0.07 and 0.09 rad; Goswami, Thuilot & Espiau
+1998 — to be tightened against docs/references.md once it lists the value), and byte-for-byte
+equality of files from interrupted and uninterrupted runs.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from amble import simulate
+from amble.analysis.poincare import find_fixed_point
+from amble.analysis.sweep import (
+    BASIN_LABELS,
+    basin,
+    bifurcation,
+    period_doubling,
+    poincare_iterates,
+    sweep_fixed_points,
+    sweep_fixed_points_2d,
+)
+from amble.cli import main
+
+SYNC = {"scheduler": "synchronous", "progress": False}
+
+
+def _state(row, names):
+    return np.array([float(row[f"x_{n}"]) for n in names])
+
+
+def test_continuation_matches_single_fixed_points(compass):
+    vals = [0.04, 0.05, 0.06]
+    res = sweep_fixed_points(compass, "slope", vals, **SYNC)
+    assert [r["status"] for r in res.rows] == ["ok"] * 3
+    assert [r["seeded"] for r in res.rows] == ["false", "true", "true"]  # continuation after the first
+    for r, s in zip(res.rows, vals):
+        x = _state(r, res.state_names)
+        single = find_fixed_point(compass, params={"slope": s})
+        assert np.max(np.abs(x - single.fixed_point)) < 1e-8
+        # both feet on the slope after impact (geometry of the section)
+        assert x[0] + x[1] == pytest.approx(2 * s, abs=1e-9)
+        # independent check of P(x*) = x*: one step of a recorded simulation
+        tr = simulate(compass, x, params={"slope": s}, steps=1, rtol=1e-12, atol=1e-12)
+        assert np.max(np.abs(tr.final_post_impact_state - x)) < 1e-8
+        assert float(r["step_time"]) == pytest.approx(tr.events[-1].t, rel=1e-8)
+
+
+def test_period_doubling_between_007_and_009(compass):
+    res = sweep_fixed_points(compass, "slope", np.linspace(0.07, 0.09, 5), **SYNC)
+    first, last = res.rows[0], res.rows[-1]
+    assert first["stable"] == "true" and last["stable"] == "false"
+    mults = [complex(re, im) for re, im in json.loads(last["multipliers"])]
+    assert any(abs(m.imag) < 1e-9 and m.real < -1 for m in mults)  # a flip, not a fold or Neimark–Sacker
+    pd = period_doubling(res)
+    assert pd is not None and 0.07 < pd < 0.09
+
+
+def test_bifurcation_period_two_beyond_the_flip(compass):
+    res = bifurcation(compass, "slope", [0.07, 0.08], transient=300, keep=8, **SYNC)
+    a, b = res.rows
+    assert a["period"] == "1" and b["period"] == "2"
+    it = json.loads(b["iterates"])
+    assert abs(it[0] - it[1]) > 1e-3  # two distinct stance angles alternate
+    # the kept state lies on the section: stance + swing = 2·slope
+    x = _state(b, res.state_names)
+    assert x[0] + x[1] == pytest.approx(2 * 0.08, abs=1e-9)
+
+
+def test_failing_point_is_recorded_and_sweep_goes_on(compass):
+    res = sweep_fixed_points(compass, "slope", [0.0, 0.05], **SYNC)  # no passive gait on level ground
+    bad, good = res.rows
+    assert bad["status"] == "failed" and "ConvergenceError" in bad["reason"]
+    assert good["status"] == "ok"
+    bif = bifurcation(compass, "slope", [0.05, 0.12], transient=50, keep=4, **SYNC)
+    assert bif.rows[0]["status"] == "ok"
+    assert bif.rows[1]["status"] == "failed" and "fell" in bif.rows[1]["reason"]
+    assert res.counts() == {"ok": 1, "failed": 1}
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_interrupted_sweep_resumes_to_identical_file(compass, tmp_path, suffix):
+    vals = np.linspace(0.03, 0.08, 7)
+    full = tmp_path / f"full{suffix}"
+    part = tmp_path / f"part{suffix}"
+    ref = sweep_fixed_points(compass, "slope", vals, chunk=4, out=full, **SYNC)
+    assert ref.complete
+    r1 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, max_points=3, **SYNC)
+    assert not r1.complete and r1.computed == 3 and len(r1.rows) == 3
+    journal = part if suffix == ".csv" else part.with_name(part.name + ".journal.csv")
+    with open(journal, "a") as f:  # a write torn by a kill: a partial last line without newline
+        f.write("3,0,0.0566")
+    r2 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, max_points=2, **SYNC)
+    assert r2.reused == 3 and r2.computed == 2
+    r3 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, **SYNC)
+    assert r3.complete and r3.computed == 2 and r3.reused == 5
+    assert part.read_bytes() == full.read_bytes()
+    r4 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, **SYNC)  # nothing left to do
+    assert r4.computed == 0 and len(r4.rows) == 7
+    assert part.read_bytes() == full.read_bytes()
+
+
+def test_file_of_another_grid_is_refused(compass, tmp_path):
+    from amble.errors import StateError
+
+    out = tmp_path / "s.csv"
+    sweep_fixed_points(compass, "slope", [0.04, 0.05], out=out, **SYNC)
+    with pytest.raises(StateError, match="another sweep"):
+        sweep_fixed_points(compass, "slope", [0.04, 0.06], out=out, **SYNC)
+
+
+def test_bifurcation_resume_identical(compass, tmp_path):
+    vals = [0.07, 0.08, 0.085]
+    kw = dict(transient=40, keep=6, chunk=3, **SYNC)
+    bifurcation(compass, "slope", vals, out=tmp_path / "a.csv", **kw)
+    bifurcation(compass, "slope", vals, out=tmp_path / "b.csv", max_points=1, **kw)
+    bifurcation(compass, "slope", vals, out=tmp_path / "b.csv", **kw)
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+
+
+def test_map_2d_grid(compass):
+    res = sweep_fixed_points_2d(compass, ("slope", "mh"), ([0.04, 0.05], [10.0, 12.0]), **SYNC)
+    assert len(res.rows) == 4 and res.counts()["ok"] == 4
+    for r in res.rows:
+        x = _state(r, res.state_names)
+        assert x[0] + x[1] == pytest.approx(2 * float(r["slope"]), abs=1e-9)
+
+
+def test_basin_small_grid(compass, tmp_path):
+    xs = find_fixed_point(compass).fixed_point
+    res = basin(compass, ("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)),
+                (3, 3), steps=40, out=tmp_path / "basin.csv", **SYNC)
+    assert res.outcome[1, 1] == BASIN_LABELS.index("converged")  # the fixed point itself
+    # stance + 0.1 rad with 0.5 rad/s less: far too slow to vault over the stance foot
+    assert res.outcome[2, 0] == BASIN_LABELS.index("fell")
+    assert sum(res.counts().values()) == 9
+    again = basin(compass, ("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)),
+                  (3, 3), steps=40, out=tmp_path / "basin.csv", **SYNC)
+    assert again.computed == 0 and np.array_equal(again.outcome, res.outcome)
+
+
+def test_plots(compass, tmp_path):
+    from amble.viz import sweep_plots as sp
+
+    fp = sweep_fixed_points(compass, "slope", [0.05, 0.085], **SYNC)
+    assert sp.plot_branch(fp, tmp_path / "b.png").stat().st_size > 1000
+    bif = bifurcation(compass, "slope", [0.05, 0.085], transient=20, keep=4, **SYNC)
+    assert sp.plot_bifurcation(bif, tmp_path / "bif.svg").stat().st_size > 1000
+    it = poincare_iterates(compass, params={"slope": 0.05}, steps=10)
+    assert it.shape == (11, 4)
+    assert sp.plot_poincare(it, tmp_path / "p.pdf", state_names=fp.state_names).stat().st_size > 1000
+    from amble.errors import AmbleError
+
+    with pytest.raises(AmbleError):
+        sp.plot_branch(fp, tmp_path / "b.txt")
+
+
+def test_cli_sweep(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    rc = main(["sweep", "compass-gait", "--param", "slope=0.07:0.09:3", "--scheduler", "synchronous",
+               "--out", str(out), "--plot", str(tmp_path / "s.png"), "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert rc == 0 and summary["ok"] == 3 and summary["failed"] == 0
+    assert 0.07 < summary["period_doubling"] < 0.09
+    assert out.exists() and (tmp_path / "s.png").exists()
+    assert main(["sweep", "compass-gait", "--param", "nope=0:1:2", "--scheduler", "synchronous"]) == 2
+    assert main(["sweep", "compass-gait", "--kind", "bifurcation", "--param", "slope=0.05:0.06:2",
+                 "--param", "mh=9:10:2", "--scheduler", "synchronous"]) == 2
+
+
+@pytest.mark.slow
+def test_local_cluster_matches_serial(compass, tmp_path):
+    xs = find_fixed_point(compass).fixed_point
+    kw = dict(n=(6, 6), steps=30)
+    rng = ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.2, xs[2] + 0.2))
+    serial = basin(compass, ("stance", "stance_dot"), rng, **kw, **SYNC)
+    dist = basin(compass, ("stance", "stance_dot"), rng, **kw, workers=2, progress=False, rows_per_task=2)
+    assert np.array_equal(serial.outcome, dist.outcome)
