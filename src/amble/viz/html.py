@@ -14,7 +14,8 @@ The page can be driven from a script:
   ``"no-webgl"`` or ``"error"``.
 * The URL hash sets the initial state, e.g. ``page.html#t=1.5`` opens paused
   at t = 1.5 s. Keys: ``t`` (seconds), ``play`` (0/1), ``speed``, ``follow``
-  (0/1), ``shadows`` (0/1), ``ui`` (0 hides the control bar and captions).
+  (0/1), ``shadows`` (0/1), ``ui`` (0 hides the control bar and captions),
+  ``view`` (``iso``, ``side`` or ``front``: the initial camera direction).
 
 Keyboard: space plays/pauses, left/right arrows step one frame.
 """
@@ -396,7 +397,10 @@ _VIEWER_JS = r"""
   const dist = followOn ? 3.2 * robotSize : Math.max(3.2 * robotSize, 1.1 * walk);
   controls.target.copy(center);
   // A side view from -y (x runs left to right), slightly raised and from ahead.
-  camera.position.copy(center).add(new THREE.Vector3(0.3, -1, 0.3).normalize()
+  // '#view=side|front|iso' picks another initial direction (figures, front view of 3D sway).
+  const views = { iso: [0.3, -1, 0.3], side: [0, -1, 0.12], front: [1, 0, 0.2] };
+  const dir = views[hash.get('view')] || views.iso;
+  camera.position.copy(center).add(new THREE.Vector3(...dir).normalize()
     .multiplyScalar(dist));
   controls.update();
 
