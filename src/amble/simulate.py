@@ -39,8 +39,9 @@ class Options:
     rtol, atol: DOP853 tolerances (relative, absolute). max_step: largest step (s, 0 = none).
     max_step_time: a walker that makes no footfall for this long has ``fell`` (s, 0 = never).
     zeno_dt, zeno_events: this many consecutive events each closer than ``zeno_dt`` (s) to the
-    previous one end the run as ``zeno``. max_events: hard cap on events. nsub: guard samples
-    per step used to find two crossings inside one integration step.
+    previous one end the run as ``zeno``. max_events: hard cap on events. nsub: uniform guard
+    samples per integration step, in addition to the extremum of the cubic through ``g`` and ``ġ``
+    at both step ends (which already finds a guard dipping through zero and back inside a step).
     """
 
     rtol: float = 1e-10
@@ -50,7 +51,7 @@ class Options:
     zeno_dt: float = 1e-6
     zeno_events: int = 5
     max_events: int = 1_000_000
-    nsub: int = 4
+    nsub: int = 1
 
 
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None) -> np.ndarray:

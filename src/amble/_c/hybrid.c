@@ -321,8 +321,9 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const long *
     double max_step = opt[OP_MAXSTEP] > 0 ? opt[OP_MAXSTEP] : INFINITY;
     double h_abs = ctx[CX_H];
     if (!(h_abs > 0.0)) h_abs = initial_step(mode, t, s.y_old, s.f_old, p, t_end, max_step, rtol, atol, s.n);
-    double g_old[NTR > 0 ? NTR : 1];
+    double g_old[NTR > 0 ? NTR : 1], gd_old[NTR > 0 ? NTR : 1], gd_new[NTR > 0 ? NTR : 1];
     guards(mode, t, s.y_old, p, g_old);
+    guards_dot(mode, t, s.y_old, s.f_old, p, gd_old);
     int status = -1;
 
     while (status < 0) {
@@ -349,9 +350,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const long *
             double th[NSUB_MAX + 1 + 2 * NTR];
             int ns = 0;
             for (int j = 0; j <= nsub; ++j) th[ns++] = (double)j / nsub;
-            double gd0[NTR > 0 ? NTR : 1], gd1[NTR > 0 ? NTR : 1];
-            guards_dot(mode, t, s.y_old, s.f_old, p, gd0);
-            guards_dot(mode, t_new, s.y, s.f, p, gd1);
+            const double *gd0 = gd_old, *gd1 = gd_new;
+            guards_dot(mode, t_new, s.y, s.f, p, gd_new);
             for (int k = 0; k < ntr; ++k) {
                 double a0 = g_old[k], a1 = s.h * gd0[k], b0 = g_new[k], b1 = s.h * gd1[k];
                 /* cubic c(θ) = a0 + a1 θ + c2 θ² + c3 θ³ matching values and slopes */
@@ -438,7 +438,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const long *
         if (ev_k < 0) {
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }
-            for (int k = 0; k < ntr; ++k) g_old[k] = g_new[k];
+            for (int k = 0; k < ntr; ++k) { g_old[k] = g_new[k]; gd_old[k] = gd_new[k]; }
             continue;
         }
         /* --- an event: record, then terminate or reset --- */
@@ -485,6 +485,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const long *
         if (TR_STEP[tr]) { ctx[CX_STEPS] += 1; ctx[CX_TLAST_STEP] = t_ev; }
         if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
         guards(mode, t, s.y_old, p, g_old);
+        guards_dot(mode, t, s.y_old, s.f_old, p, gd_old);
         if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) { status = ST_ZENO; break; }
         if (max_steps > 0 && ctx[CX_STEPS] >= max_steps) { status = ST_STEPS_DONE; break; }
         if (max_events > 0 && ctx[CX_EVENTS] >= max_events) { status = ST_MAX_EVENTS; break; }
