@@ -123,3 +123,22 @@ def test_body_inertia_of_a_3d_body():
     eq = derive(m)
     expected = sp.Matrix([[B * sp.sin(r) ** 2 + C * sp.cos(r) ** 2, 0], [0, A]])
     assert sp.simplify(eq.M - expected) == sp.zeros(2, 2)
+
+
+def test_constrained_model_equals_the_model_written_with_the_constraint():
+    # A double pendulum with both links locked together is a single rigid pendulum: deriving the
+    # constrained copy must give the same equations as writing the rigid pendulum directly, and a
+    # torque on the eliminated angle must act on the remaining one (virtual work).
+    m = _double_pendulum()
+    q1, q2 = m.q
+    tau = m.parameter("tau", 1.0)
+    m.torque(tau, q2)
+    c = m.constrained("rigid", {q2: q1})
+    m1, m2, l1, l2, g = (m.symbol(n) for n in ("m1", "m2", "l1", "l2", "g"))
+    M = m1 * l1**2 + m2 * (l1 + l2) ** 2
+    G = (m1 * l1 + m2 * (l1 + l2)) * g * sp.sin(q1)
+    eq = derive(c)
+    assert c.q == [q1]
+    assert sp.simplify(eq.M[0, 0] - M) == 0
+    assert sp.simplify(eq.h[0] - G) == 0
+    assert eq.Gamma[0] == tau

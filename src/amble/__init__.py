@@ -20,11 +20,11 @@ from .hybrid import Explicit, Guard, HybridSystem, Impact, Lock
 from .model import R3, Model, R, t, vector
 from .simulate import Options, simulate
 from .trajectory import Event, Trajectory
-from .walker import distance_along_slope, heel_strike, height_above_slope, walker
+from .walker import distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
 
 __all__ = [
     "AmbleError", "CompileError", "ConvergenceError", "Equations", "Event", "Explicit", "Guard",
     "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "ParameterError", "R", "R3",
     "SimulationError", "StateError", "Trajectory", "derive", "distance_along_slope", "heel_strike",
-    "height_above_slope", "simulate", "t", "vector", "walker",
+    "height_above_slope", "joint_lock", "simulate", "t", "vector", "walker",
 ]

@@ -280,8 +280,8 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
     body = f"    *target = {dst.index};\n"
     reset = tr.reset
     if isinstance(reset, Explicit):
-        qn = target_exprs(dst.model, reset.q, what)
-        vn = target_exprs(dst.model, reset.qd, what, velocities=True)
+        qn = target_exprs(dst.model, reset.q, what, source=m)
+        vn = target_exprs(dst.model, reset.qd, what, velocities=True, source=m)
         body += f"    double y[{2 * nd}];\n"
         body += _block([f"y[{j}]" for j in range(2 * nd)], qn + vn, nm)
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
@@ -294,7 +294,7 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
     else:  # pragma: no cover - validated earlier
         raise ModelError(f"{what}: unsupported reset {reset!r}")
     ne, nc = Me.shape[0], Jc.shape[0]
-    qn = target_exprs(dst.model, reset.relabel, what)
+    qn = target_exprs(dst.model, reset.relabel, what, source=m)
     dq = sp.Matrix(qn).jacobian(m.q)  # velocity map of the relabelling
     body += f"    double Me[{ne * ne}], Jc[{nc * ne}], v[{ne}], qn[{nd}], T[{nd * n}];\n"
     tg = [f"Me[{a * ne + b}]" for a in range(ne) for b in range(ne)]

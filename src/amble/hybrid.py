@@ -171,12 +171,22 @@ class HybridSystem:
         self.transitions.append(tr)
         return tr
 
-    def terminal(self, name: str, source: str, guard: Guard, status: str = "fell") -> Transition:
-        """Add a guard that ends the run with ``status`` (e.g. the hip touching the ground)."""
-        self._check_mode(source)
-        self._check_guard(source, guard)
-        tr = Transition(name, source, source, guard, None, status, False)
-        self.transitions.append(tr)
+    def terminal(self, name: str, source: str | Sequence[str], guard: Guard | Any, status: str = "fell"
+                 ) -> Transition:
+        """Add a guard that ends the run with ``status`` (e.g. the hip touching the ground).
+
+        ``source`` may list several modes; ``guard`` is then a Guard or a function ``model →
+        Guard`` evaluated per mode (each transition is named ``<name>_<mode>``).
+        """
+        sources = [source] if isinstance(source, str) else list(source)
+        tr = None
+        for src in sources:
+            self._check_mode(src)
+            g = guard if isinstance(guard, Guard) else guard(self.modes[src])
+            self._check_guard(src, g)
+            tr = Transition(name if len(sources) == 1 else f"{name}_{src}", src, src, g, None, status, False)
+            self.transitions.append(tr)
+        assert tr is not None
         return tr
 
     # ------------------------------------------------------------------ queries
@@ -237,14 +247,19 @@ class HybridSystem:
                 )
 
 
-def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = False) -> list[sp.Expr]:
-    """Order a relabel mapping (or sequence) by the target mode's coordinates."""
+def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = False,
+                 source: Model | None = None) -> list[sp.Expr]:
+    """Order a relabel mapping (or sequence) by the target mode's coordinates. With a mapping, a
+    target coordinate that the source mode also has and the mapping omits is kept as it is."""
     names = [str(s) for s in (target.qd if velocities else target.q)]
     if isinstance(mapping, Mapping):
         given = {str(k): sp.sympify(v) for k, v in mapping.items()}
         unknown = sorted(set(given) - set(names))
         if unknown:
             raise ModelError(f"{what}: {', '.join(unknown)} not among the target coordinates {names}")
+        if source is not None:
+            for s_ in (source.qd if velocities else source.q):
+                given.setdefault(str(s_), s_)
         missing = [n for n in names if n not in given]
         if missing:
             raise ModelError(f"{what}: no value for target coordinate(s) {', '.join(missing)}")
@@ -260,16 +275,16 @@ def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
     if isinstance(reset, Impact):
         if reset.point not in src.points:
             raise ModelError(f"{what}: impact point {reset.point!r} is not a point of mode {src.name!r}")
-        exprs = target_exprs(dst, reset.relabel, what)
+        exprs = target_exprs(dst, reset.relabel, what, source=src)
         _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
     elif isinstance(reset, Lock):
         c = sp.sympify(reset.constraint)
         if not (c.free_symbols & set(src.q)):
             raise ModelError(f"{what}: lock constraint {c} does not depend on the coordinates")
-        exprs = target_exprs(dst, reset.relabel, what)
+        exprs = target_exprs(dst, reset.relabel, what, source=src)
         _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
     elif isinstance(reset, Explicit):
-        exprs = target_exprs(dst, reset.q, what) + target_exprs(dst, reset.qd, what, velocities=True)
+        exprs = target_exprs(dst, reset.q, what, source=src) + target_exprs(dst, reset.qd, what, True, src)
         allowed = set(src.q) | set(src.qd) | set(src.params) | {sp.Symbol("t", real=True)}
         _check_free(exprs, allowed, what, "source state")
         if reset.shift is not None and reset.shift not in src.points:

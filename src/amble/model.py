@@ -300,6 +300,44 @@ class Model:
             out += f
         return out
 
+    # ------------------------------------------------------------------ derived models
+    def constrained(self, name: str, substitutions: dict[Any, Any]) -> Model:
+        """A copy of this model with some coordinates tied to the others (e.g. a locked knee:
+        ``{shank: thigh}``), for a mode with fewer coordinates.
+
+        Positions, energies and masses are substituted; generalized forces are mapped by virtual
+        work, ``Γ_new = (∂q/∂q_new)ᵀ Γ``, so a torque declared once acts correctly in both modes.
+        """
+        subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
+        for k in subs:
+            if k not in self.q:
+                raise ModelError(f"model {self.name!r}: {k} is not a coordinate and cannot be eliminated")
+        out = Model(name, self.dims)
+        keep = [i for i, qi in enumerate(self.q) if qi not in subs]
+        out.q = [self.q[i] for i in keep]
+        out.qd = [self.qd[i] for i in keep]
+        out.params, out.param_docs = dict(self.params), dict(self.param_docs)
+        for qi, v in subs.items():
+            bad = v.free_symbols - set(out.q) - set(self.params) - {t}
+            if bad:
+                raise ModelError(f"model {self.name!r}: {qi} = {v} uses {', '.join(map(str, bad))}")
+        vsubs = dict(subs)
+        vsubs.update({self.dot(qi): out.dt(v) for qi, v in subs.items()})
+        out.points = {n: p.subs(subs) for n, p in self.points.items()}
+        out.masses = dict(self.masses)
+        out.links = list(self.links)
+        out._k_terms = [e.subs(vsubs) for e in self._k_terms]
+        out._v_terms = [e.subs(subs) for e in self._v_terms]
+        for attr in ("_k_override", "_v_override", "_l_override"):
+            e = getattr(self, attr)
+            setattr(out, attr, None if e is None else e.subs(vsubs))
+        full = sp.Matrix([subs.get(qi, qi) for qi in self.q])
+        jac = full.jacobian(out.q)
+        out._forces = [jac.T * f.subs(vsubs) for f in self._forces]
+        out._g, out._g_dir = self._g, self._g_dir
+        out.look = list(self.look)
+        return out
+
     # ------------------------------------------------------------------ helpers
     @property
     def parameter_names(self) -> list[str]:

@@ -13,7 +13,7 @@ from typing import Any
 
 import sympy as sp
 
-from .hybrid import Guard, HybridSystem, Impact
+from .hybrid import Guard, HybridSystem, Impact, Lock
 from .model import Model
 
 
@@ -38,6 +38,13 @@ def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any])
     followed by a plastic impact and the leg relabelling."""
     guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > 0)
     return guard, Impact(foot, relabel)
+
+
+def joint_lock(constraint: Any, relabel: Mapping[Any, Any] | None = None) -> tuple[Guard, Lock]:
+    """Guard and reset of a joint that locks when ``constraint`` (e.g. ``shank − thigh``, thesis
+    Eq. 27) falls through zero: the lock impulse (Eq. 28), then the mode without the joint
+    (``relabel`` may omit coordinates both modes share)."""
+    return Guard(constraint, -1), Lock(constraint, relabel or {})
 
 
 def walker(

@@ -29,23 +29,21 @@ x* with torso (0.03, 0.05): not comparable, see kneed-biped.)
 
 import sympy as sp
 
-from amble import HybridSystem, Model, R
-from amble.models.kneed_biped import kneed_walker
+from amble import HybridSystem, R
+from amble.models.kneed_biped import kneed_model, kneed_walker
 
 NAME = "humanoid-2d"
 
 
-def torso(m: Model, stance: sp.Symbol, thigh: sp.Symbol, tr: sp.Symbol) -> None:
-    """Add the torso, its PD torque against the stance leg and the swing-leg torque (Eq. 34–35)."""
+def build() -> HybridSystem:
+    m = kneed_model(NAME, "torso")
+    st, sh, th, tr = m.q
     mT, lT, kT, kv, theta_d, kleg = m.parameters(mT=3.0, lT=0.5, kT=100.0, kv=10.0, theta_d=0.0, kleg=5.0)
     m.point("torso", m.points["hip"] + lT * R(tr), mass=mT, link="hip")
-    m.torque(kT * (theta_d - tr) - kv * m.dot(tr), tr - stance)
-    step_length = -m.points["swing_foot"][0]
-    m.torque(sp.Piecewise((-kleg * step_length, step_length > 0), (0, True)), thigh)
-
-
-def build() -> HybridSystem:
-    s = kneed_walker(NAME, __doc__, "torso", torso)
+    m.torque(kT * (theta_d - tr) - kv * m.dot(tr), tr - st)  # Eq. 34, reacting on the stance leg
+    step_length = -m.points["swing_foot"][0]  # Eq. 35: positive while the swing foot is behind
+    m.torque(sp.Piecewise((-kleg * step_length, step_length > 0), (0, True)), th)
+    s = kneed_walker(m, __doc__)
     # the stable limit cycle at the defaults (post-impact state; step 0.7827 s, |multipliers| ≤ 0.381)
     s.default_start["unlocked"] = s.fixed_point_guess = [-0.2206099995, 0.3206099995, 0.3206099995, -0.0442356769,
                                                          0.9708804245, 0.4105759175, 0.4105759175, 0.4637318092]

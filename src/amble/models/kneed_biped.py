@@ -2,8 +2,8 @@
 
 Coordinates: absolute angles from the vertical, foot → hip direction ``R(θ)``, positive leaning
 downhill (+x), as in the compass gait. Mode "unlocked": ``stance, shank, thigh`` (swing shank
-and thigh free); mode "locked": ``stance, swing`` (swing knee straight). The stance leg is
-always straight. Each leg carries a shank mass ``ms`` and a thigh mass ``mt``::
+and thigh free); mode "locked": ``stance, thigh`` (swing knee straight, shank = thigh). The
+stance leg is always straight. Each leg carries a shank mass ``ms`` and a thigh mass ``mt``::
 
                        hip (mh)
                       /    \\
@@ -42,49 +42,47 @@ signs (angles counter-clockwise) at best, and lies on no heel-strike section of 
 (stance + swing would be ∓0.1): it cannot be compared beyond its signs.
 """
 
-from amble import Guard, HybridSystem, Lock, Model, R, heel_strike, height_above_slope
+from amble import Guard, HybridSystem, Model, R, heel_strike, height_above_slope, joint_lock
 
 NAME = "kneed-biped"
 
 
-def kneed_walker(name: str, doc: str, extra: str = "", add=lambda model, stance, thigh, *extra: None) -> HybridSystem:
-    """The two-mode kneed walker: modes "unlocked" (coordinates ``stance shank thigh``, then the
-    names in ``extra``) and "locked" (``stance swing``, then ``extra``); ``add`` extends each mode
-    (the humanoid's torso). Knee lock (Eq. 27–28), heel strike with the relabelling of Eq. 29
-    (extra coordinates kept), a bent-knee footfall ("scuffed") and the hip on the ground ("fell")."""
-    modes = {}
-    for mode, coordinates in (("unlocked", "stance shank thigh "), ("locked", "stance swing ")):
-        m = modes[mode] = Model(f"{name}-{mode}")
-        q = m.coordinates(coordinates + extra)
-        st, sh, th = q[:3] if mode == "unlocked" else (q[0], q[1], q[1])  # a locked knee: shank = thigh
-        mh, mt, ms, a1, b1, a2, b2, It, Is, g, slope = m.parameters(
-            mh=10.0, mt=3.5, ms=1.5, a1=0.25, b1=0.25, a2=0.15, b2=0.35, It=0.0, Is=0.0, g=9.81, slope=0.05)
-        m.point("stance_foot", (0, 0))
-        m.point("stance_shank", a1 * R(st), mass=ms)
-        m.point("stance_thigh", (a1 + b1 + a2) * R(st), mass=mt)
-        hip = m.point("hip", (a1 + b1 + a2 + b2) * R(st), mass=mh, link="stance_foot")
-        m.point("swing_thigh", hip - b2 * R(th), mass=mt)
-        knee = m.point("swing_knee", hip - (a2 + b2) * R(th), link="hip")
-        m.point("swing_shank", knee - b1 * R(sh), mass=ms)
-        m.point("swing_foot", knee - (a1 + b1) * R(sh), link="swing_knee")
-        for angle, inertia in ((st, It + Is), (th, It), (sh, Is)):  # distributed mass (McGeer's gyration radii)
-            m.inertia(angle, inertia)
-        add(m, st, th, *q[3 if mode == "unlocked" else 2:])
-        m.gravity(g)
-    (st, sh, th, *xu), (st_l, sw, *xl) = modes["unlocked"].q, modes["locked"].q
-    s = HybridSystem(name, modes, ground_slope=slope, hip="hip", doc=doc)
-    s.transition("knee_lock", "unlocked", Guard(sh - th), Lock(sh - th, {st_l: st, sw: th, **dict(zip(xl, xu))}),
-                 "locked")
-    strike = heel_strike(modes["locked"], "swing_foot", slope, {st: sw, sh: st_l, th: st_l, **dict(zip(xu, xl))})
-    s.transition("heel_strike", "locked", *strike, "unlocked", step=True)
-    s.terminal("scuffed", "unlocked", heel_strike(modes["unlocked"], "swing_foot", slope, {})[0], status="scuffed")
-    for mode, m in modes.items():
-        s.terminal(f"hip_on_ground_{mode}", mode, Guard(height_above_slope(m, "hip", slope)), status="fell")
+def kneed_model(name: str, extra: str = "") -> Model:
+    """The unlocked kneed walker (coordinates ``stance shank thigh``, then ``extra``)."""
+    m = Model(name)
+    st, sh, th, *_ = m.coordinates("stance shank thigh " + extra)
+    mh, mt, ms, a1, b1, a2, b2, It, Is, g, slope = m.parameters(
+        mh=10.0, mt=3.5, ms=1.5, a1=0.25, b1=0.25, a2=0.15, b2=0.35, It=0.0, Is=0.0, g=9.81, slope=0.05)
+    m.point("stance_foot", (0, 0))
+    m.point("stance_shank", a1 * R(st), mass=ms)
+    m.point("stance_thigh", (a1 + b1 + a2) * R(st), mass=mt)
+    hip = m.point("hip", (a1 + b1 + a2 + b2) * R(st), mass=mh, link="stance_foot")
+    m.point("swing_thigh", hip - b2 * R(th), mass=mt)
+    knee = m.point("swing_knee", hip - (a2 + b2) * R(th), link="hip")
+    m.point("swing_shank", knee - b1 * R(sh), mass=ms)
+    m.point("swing_foot", knee - (a1 + b1) * R(sh), link="swing_knee")
+    for angle, inertia in ((st, It + Is), (th, It), (sh, Is)):  # distributed mass (McGeer's gyration radii)
+        m.inertia(angle, inertia)
+    m.gravity(g)
+    return m
+
+
+def kneed_walker(m: Model, doc: str) -> HybridSystem:
+    """Modes "unlocked" and "locked" (knee straight: shank = thigh), the knee lock (Eq. 27–28),
+    heel strike with the relabelling of Eq. 29, a bent-knee footfall ("scuffed") and falls."""
+    (st, sh, th, *_), slope = m.q, m.symbol("slope")
+    locked = m.constrained(f"{m.name}-locked", {sh: th})
+    s = HybridSystem(m.name, {"unlocked": m, "locked": locked}, ground_slope=slope, hip="hip", doc=doc)
+    s.transition("knee_lock", "unlocked", *joint_lock(sh - th), "locked")
+    s.transition("heel_strike", "locked", *heel_strike(locked, "swing_foot", slope, {st: th, sh: st, th: st}),
+                 "unlocked", step=True)
+    s.terminal("scuffed", "unlocked", heel_strike(m, "swing_foot", slope, {})[0], status="scuffed")
+    s.terminal("hip_on_ground", ["unlocked", "locked"], lambda mode: Guard(height_above_slope(mode, "hip", slope)))
     return s
 
 
 def build() -> HybridSystem:
-    s = kneed_walker(NAME, __doc__)
+    s = kneed_walker(kneed_model(NAME), __doc__)
     # the stable limit cycle at the defaults (post-impact state; step 0.7327 s, |multipliers| 0.697, 0.697, 0.077)
     s.default_start["unlocked"] = s.fixed_point_guess = [-0.2224446318, 0.3224446318, 0.3224446318, 1.098070999,
                                                          0.5532765919, 0.5532765919]
