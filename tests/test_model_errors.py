@@ -25,3 +25,63 @@ def test_wrong_dimension_point():
     (q,) = m.coordinates("q")
     with pytest.raises(ModelError, match="3 for a 3D"):
         m.point("p", (q, 0))
+
+
+def _pendulum():
+    m = Model("pendulum")
+    (q,) = m.coordinates("q")
+    (g,) = m.parameters(g=9.81)
+    m.point("bob", (sp.sin(q), -sp.cos(q)), mass=1)
+    m.gravity(g)
+    return m
+
+
+def test_guard_that_does_not_depend_on_the_state():
+    from amble import Guard, HybridSystem
+
+    m = _pendulum()
+    s = HybridSystem("p", m)
+    with pytest.raises(ModelError, match="does not depend on the state"):
+        s.terminal("never", "pendulum", Guard(m.symbol("g") - 1))
+
+
+def test_reset_to_unknown_or_missing_target_coordinates():
+    from amble import Explicit, HybridSystem, Impact
+
+    m = _pendulum()
+    (q,) = m.q
+    s = HybridSystem("p", m)
+    with pytest.raises(ModelError, match="not among the target coordinates"):
+        s.transition("bad", "pendulum", __import__("amble").Guard(q), Impact("bob", {"nope": q}))
+    with pytest.raises(ModelError, match="impact point"):
+        s.transition("bad", "pendulum", __import__("amble").Guard(q), Impact("elbow", {}))
+    with pytest.raises(ModelError, match="values for"):
+        s.transition("bad", "pendulum", __import__("amble").Guard(q), Explicit(q=[q, q], qd=[q]))
+
+
+def test_unknown_mode_and_parameter_clash():
+    from amble import Guard, HybridSystem
+
+    m = _pendulum()
+    s = HybridSystem("p", m)
+    with pytest.raises(ModelError, match="unknown mode"):
+        s.terminal("x", "nowhere", Guard(m.q[0]))
+    other = Model("other")
+    other.coordinates("r")
+    other.parameters(g=1.0)
+    with pytest.raises(ModelError, match="defaults"):
+        HybridSystem("clash", {"a": _pendulum(), "b": other})
+
+
+def test_impact_needs_point_masses():
+    from amble import Guard, HybridSystem, Impact, simulate
+
+    m = Model("k-outright")
+    (q,) = m.coordinates("q")
+    m.point("tip", (sp.sin(q), -sp.cos(q)))
+    m.K = m.dot(q) ** 2 / 2
+    m.V = -sp.cos(q)
+    s = HybridSystem("k", m)
+    s.transition("hit", "k-outright", Guard(q), Impact("tip", {}))
+    with pytest.raises(ModelError, match="point masses"):
+        simulate(s, [0.5, 0.0], t_end=1.0)

@@ -135,3 +135,36 @@ def test_changing_a_default_is_seen_without_recompiling():
     ta = amble.simulate(a, [0.0, 1.0, 0.0, 0.0], t_end=5.0).events[-1].t
     tb = amble.simulate(b, [0.0, 1.0, 0.0, 0.0], t_end=5.0).events[-1].t
     assert abs(ta - math.sqrt(2 / 9.81)) < 1e-10 and abs(tb - math.sqrt(2 / 1.62)) < 1e-10  # ...own defaults
+
+
+def test_grazing_contact_does_not_fire():
+    # A ball thrown up to exactly the guard's level touches g = 0 without crossing: no event.
+    m = _falling_mass()
+    x, z = m.q
+    sys_ = HybridSystem("graze", m)
+    sys_.terminal("hit", "falling-mass", Guard(-(z - 1.0), +1), status="hit")  # fires on crossing z = 1 upward
+    v = math.sqrt(2 * 9.81 * 0.999)  # apex at 0.999 m: below the guard, never crosses
+    tr = amble.simulate(sys_, [0.0, 0.0, 0.0, v], t_end=0.5)
+    assert tr.status == "end_time" and not tr.events
+
+
+def test_event_storm_ends_as_zeno_not_a_hang():
+    # Restitution 1 with the ball at rest on the ground: every step re-triggers the guard.
+    m = _falling_mass()
+    x, z = m.q
+    xd, zd = m.qd
+    sys_ = HybridSystem("storm", m)
+    sys_.transition("bounce", "falling-mass", Guard(z, -1), Explicit(q=[x, 0.0], qd=[xd, -0.1 * zd]))
+    tr = amble.simulate(sys_, [0.0, 1e-9, 0.0, 0.0], t_end=10.0)
+    assert tr.status == "zeno"
+
+
+def test_blow_up_is_reported_not_passed_on():
+    # q̈ = q³ (a potential −q⁴/4) reaches infinity in finite time: the run must end with a status.
+    m = Model("blowup")
+    (q,) = m.coordinates("q")
+    m.point("p", (q, 0), mass=1)
+    m.add_potential(-(q**4) / 4)
+    tr = amble.simulate(HybridSystem("blowup", m), [1.0, 1.0], t_end=10.0)
+    assert tr.status == "integrator_failure"
+    assert np.all(np.isfinite(tr.x[:-1]))

@@ -253,10 +253,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
-    for text in args.param:  # validate ranges before any work starts
-        parse_range(text)
-    if len(args.param) > 2:
-        raise UsageError("--param can be given once (1D sweep) or twice (2D map)")
+    # options are checked (UsageError, exit 2) in sweep_cli before any file is touched or work starts
     from .analysis.sweep import sweep_cli
 
     return sweep_cli(args)
@@ -313,15 +310,26 @@ def build_parser() -> argparse.ArgumentParser:
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.set_defaults(func=cmd_limit_cycle)
-    sw = add("sweep", "parameter sweep: fixed points / bifurcation diagram, on Dask")
+    sw = add("sweep", "parameter sweep (fixed points, bifurcation diagram) or basin of attraction, on Dask")
     model_args(sw, 1e-10)
-    sw.add_argument("--param", action="append", required=True, metavar="NAME=START:STOP:COUNT",
-                    help="swept parameter (give one for a 1D sweep, two for a 2D map)")
-    sw.add_argument("--kind", choices=("fixed-point", "bifurcation"), default="fixed-point",
-                    help="continuation of the fixed point, or post-transient iterates (bifurcation)")
+    sw.add_argument("--kind", choices=("fixed-point", "bifurcation", "basin"), default="fixed-point",
+                    help="continuation of the fixed point (default), post-transient iterates (bifurcation), "
+                         "or which initial post-impact states walk into the gait (basin)")
+    sw.add_argument("--param", action="append", metavar="NAME=START:STOP:COUNT",
+                    help="swept parameter: give one for a branch or bifurcation diagram, two for a 2D map "
+                         "(fixed-point and bifurcation kinds)")
+    sw.add_argument("--x", action="append", metavar="NAME=START:STOP:COUNT",
+                    help="--kind basin: a coordinate of the initial post-impact state, give exactly two "
+                         "(e.g. --x stance=-0.4:0:100 --x stance_dot=0.5:1.6:100); the other coordinates "
+                         "come from the fixed point (compass-like walkers: swing = 2*slope - stance)")
+    sw.add_argument("--steps", type=int, default=None,
+                    help="--kind basin: footfalls walked from each initial state at most (default 60)")
     sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")
     sw.add_argument("--plot", help="write a plot FILE.png|.svg|.pdf")
-    sw.add_argument("--scheduler", help="address of an existing Dask scheduler (default: local processes)")
+    sw.add_argument("--scheduler",
+                    help="'synchronous': run in this process, without Dask (small runs, debugging); or the "
+                         "address of an existing Dask scheduler, e.g. tcp://host:8786 (default: local "
+                         "worker processes)")
     sw.add_argument("--workers", type=int, default=None, help="local Dask worker processes (default: cores)")
     sw.set_defaults(func=cmd_sweep)
     return p

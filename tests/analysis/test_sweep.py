@@ -10,6 +10,7 @@ equality of files from interrupted and uninterrupted runs.
 
 from __future__ import annotations
 
+import csv
 import json
 
 import numpy as np
@@ -182,3 +183,31 @@ def test_local_cluster_matches_serial(compass, tmp_path):
     serial = basin(compass, ("stance", "stance_dot"), rng, **kw, **SYNC)
     dist = basin(compass, ("stance", "stance_dot"), rng, **kw, workers=2, progress=False, rows_per_task=2)
     assert np.array_equal(serial.outcome, dist.outcome)
+
+
+def test_cli_basin(compass, tmp_path, capsys):
+    xs = find_fixed_point(compass).fixed_point  # (stance, swing, stance_dot, swing_dot)
+    out = tmp_path / "basin.csv"
+    grid = ["--x", f"stance={xs[0] - 0.1}:{xs[0] + 0.1}:3", "--x", f"stance_dot={xs[2] - 0.5}:{xs[2] + 0.5}:3"]
+    rc = main(["sweep", "compass-gait", "--kind", "basin", *grid, "--steps", "40", "--scheduler", "synchronous",
+               "--out", str(out), "--plot", str(tmp_path / "basin.png"), "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert rc == 0 and summary["points"] == 9 and summary["complete"]
+    assert sum(summary[lab] for lab in BASIN_LABELS) == 9
+    rows = {(r["i"], r["j"]): r for r in csv.DictReader(out.open())}
+    assert rows["1", "1"]["outcome"] == "converged"  # the fixed point itself
+    assert rows["2", "0"]["outcome"] == "fell"  # 0.1 rad further back, 0.5 rad/s slower: cannot vault over
+    assert (tmp_path / "basin.png").stat().st_size > 1000
+    bad = [
+        ["--kind", "basin", "--x", "stance=-0.3:-0.1:3"],  # one coordinate
+        ["--kind", "basin", *grid, "--param", "slope=0.04:0.05:2"],  # parameters are --set in a basin
+        ["--kind", "basin", "--x", "stance=-0.3:-0.1:3", "--x", "nope=0:1:3"],  # not a state coordinate
+        ["--kind", "basin", "--x", "stance=-0.3:-0.1:3", "--x", "stance=0:1:3"],  # the same one twice
+        ["--kind", "basin", *grid, "--steps", "0"],
+        ["--kind", "basin", "--x", "stance=-0.3:-0.1", "--x", "stance_dot=1:2:3"],  # no count
+        ["--param", "slope=0.04:0.05:2", "--steps", "10"],  # --steps is for basins
+        ["--kind", "fixed-point"],  # no --param
+    ]
+    for extra in bad:
+        assert main(["sweep", "compass-gait", *extra, "--scheduler", "synchronous"]) == 2, extra
+    assert "--x expects" in capsys.readouterr().err

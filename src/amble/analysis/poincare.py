@@ -274,6 +274,10 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
     else:
         raise ConvergenceError(f"no convergence in {max_iter} iterations (residual {res:.3g})")
     xs = y
+    if np.max(np.abs(xs)) < 1e-3:
+        # On level ground the iteration can creep towards the walker at rest, where every residual is
+        # tiny because the state is: that is not a gait.
+        raise ConvergenceError("the iteration converged to the walker at rest (all states below 1e-3), not a gait")
     Px, T = P(xs)
     S, E = _chart(P.section_basis(xs))
     A = _jacobian(P, xs, E, S)

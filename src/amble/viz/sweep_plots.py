@@ -160,8 +160,7 @@ def plot_basin(result: Any, path: str | os.PathLike, *, title: str | None = None
 
     a, b = result.names
     labels = list(result.labels)
-    cmap = ListedColormap(list(BASIN_COLOURS[: len(labels)]))
-    cmap.set_under("white")
+    cmap = ListedColormap(list(BASIN_COLOURS[: len(labels)])).with_extremes(under="white")  # white: not computed
     norm = BoundaryNorm(np.arange(-0.5, len(labels) + 0.5), cmap.N)
     fig, ax = plt.subplots(figsize=(6.5, 5))
     av, bv = result.a_values, result.b_values

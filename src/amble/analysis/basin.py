@@ -1,0 +1,218 @@
+"""Basins of attraction: which initial post-impact states of a grid walk into the period-1 gait.
+
+Each cell of a grid over two coordinates of the post-impact state is walked with the compiled
+run loop (no recording) for a bounded number of footfalls and classified as ``converged``
+(reached the fixed point), ``fell``, ``not converged`` (kept walking elsewhere) or ``failed``
+(any other run outcome, with its reason). Cells are independent, so a resumed basin equals an
+uninterrupted one exactly; one Dask task covers a few grid rows.
+
+Units: angles in rad, angular velocities in rad/s; parameters in the model's units.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import StateError
+from ..hybrid import HybridSystem
+from ..kernels import CTX_X, build
+from ..simulate import Options, parameter_vector, run
+from .runner import COMPLETED, chunks, execute, open_client, status_name, sweep_values
+from .store import ResultStore, fmt_value
+
+#: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
+BASIN_LABELS = ("converged", "fell", "not converged", "failed")
+
+
+@dataclass
+class BasinResult:
+    """Basin of attraction on a grid of two initial-condition coordinates.
+
+    ``outcome[i, j]`` is an index into ``labels`` for initial values ``a_values[i]``,
+    ``b_values[j]``; ``steps[i, j]`` footfalls taken; ``distance[i, j]`` final
+    ``|x − x*|∞`` (NaN if the walk did not complete); ``reasons[i, j]`` why a walk ended early
+    (``""`` when it did not, e.g. ``"fell"``, ``"integrator_failure"``). ``computed``: cells
+    computed by this call (the others were read back from the result file).
+    """
+
+    names: tuple[str, str]
+    a_values: np.ndarray
+    b_values: np.ndarray
+    outcome: np.ndarray
+    steps: np.ndarray
+    distance: np.ndarray
+    fixed_point: np.ndarray
+    labels: tuple[str, ...] = BASIN_LABELS
+    path: str | None = None
+    computed: int = 0
+    state_names: list[str] = field(default_factory=list)
+    reasons: np.ndarray | None = None
+
+    def counts(self) -> dict[str, int]:
+        return {lab: int(np.sum(self.outcome == c)) for c, lab in enumerate(self.labels)}
+
+class SetCoordinates:
+    """Default map (a, b) → full state: put the two values into the base state.
+
+    For a compass-like walker (coordinates ``stance`` and ``swing``, parameter ``slope``) with
+    ``swing`` not among the varied coordinates, the post-impact section constraint (both feet on
+    the slope) ``swing = 2·slope − stance`` is enforced (rad).
+    """
+
+    def __init__(self, state_names: Sequence[str], names: tuple[str, str], slope: float | None) -> None:
+        self.idx = [list(state_names).index(n) for n in names]
+        sn = list(state_names)
+        self.pair = (sn.index("stance"), sn.index("swing")) if (
+            slope is not None and "stance" in sn and "swing" in sn and "swing" not in names) else None
+        self.slope = slope
+
+    def __call__(self, a: float, b: float, base: np.ndarray) -> np.ndarray:
+        x = base.copy()
+        x[self.idx[0]], x[self.idx[1]] = a, b
+        if self.pair is not None:
+            x[self.pair[1]] = 2.0 * self.slope - x[self.pair[0]]
+        return x
+
+
+def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
+                base: list[float], fixed: list[float], to_state: Callable, steps: int, check_every: int, tol: float,
+                rtol: float, atol: float) -> list[dict[str, Any]]:
+    """One or more grid rows: walk each cell with the compiled run loop, no recording."""
+    k = build(system)
+    mi = 0
+    n = k.meta["nx"][mi]
+    p = np.asarray(pvec, float)
+    xs = np.asarray(fixed, float)
+    b0 = np.asarray(base, float)
+    opts = Options(rtol=rtol, atol=atol, max_step_time=getattr(system, "max_step_time", 0.0) or 0.0)
+    out = []
+    for i, a in rows:
+        for j, b in enumerate(b_values):
+            x = np.asarray(to_state(a, b, b0), float)
+            done, code, dist, reason = 0, 0, math.nan, ""
+            if x.shape != (n,) or not np.all(np.isfinite(x)):
+                code, reason = 3, "invalid initial state"
+            else:
+                while done < steps:
+                    m = min(check_every, steps - done)
+                    st, ctx, _ = run(k, p, mi, x, steps=m, opts=opts)
+                    if st != COMPLETED:
+                        done += int(ctx[3])
+                        name = status_name(k, st, ctx)
+                        code, reason = (1 if name == "fell" else 3), name
+                        break
+                    done += m
+                    x = ctx[CTX_X:CTX_X + n].copy()
+                    dist = float(np.max(np.abs(x - xs)))
+                    if dist < tol:
+                        break
+                if not reason:
+                    code = 0 if dist < tol else 2
+            out.append({"i": i, "j": j, "a": float(a), "b": float(b), "outcome": BASIN_LABELS[code],
+                        "reason": reason, "steps": done, "distance": dist})
+    return out
+
+
+def basin(
+    system: HybridSystem,
+    x_names: tuple[str, str],
+    ranges: tuple[tuple[float, float], tuple[float, float]],
+    n: tuple[int, int] = (100, 100),
+    *,
+    params: Mapping[str, float] | None = None,
+    base_state: Sequence[float] | None = None,
+    to_state: Callable[[float, float, np.ndarray], np.ndarray] | None = None,
+    steps: int = 60,
+    check_every: int = 5,
+    tol: float = 1e-4,
+    rows_per_task: int = 5,
+    out: str | os.PathLike | None = None,
+    scheduler: Any = None,
+    workers: int | None = None,
+    progress: bool = True,
+    max_points: int | None = None,
+    rtol: float = 1e-8,
+    atol: float = 1e-8,
+) -> BasinResult:
+    """Basin of attraction of the period-1 gait over two post-impact coordinates.
+
+    The grid is ``n[0]`` values of ``x_names[0]`` over ``ranges[0]`` × ``n[1]`` values of
+    ``x_names[1]`` over ``ranges[1]``; the other coordinates come from ``base_state`` (default:
+    the fixed point at ``params``). ``to_state(a, b, base) → full state`` overrides the
+    embedding (default :class:`SetCoordinates`, which respects the compass gait's section). Each
+    cell walks up to ``steps`` footfalls (checked every ``check_every``) and is ``converged`` if
+    ``|x − x*|∞ < tol``, ``fell`` if a terminal/fall event ended it, ``not converged`` if it kept
+    walking elsewhere (another attractor or too slow), ``failed`` for any other run status.
+    One Dask task per ``rows_per_task`` grid rows. ``rtol``/``atol``: integrator tolerances
+    (looser than for fixed points: only the outcome category matters here).
+    """
+    from .poincare import find_fixed_point
+
+    k = build(system)
+    pvec = parameter_vector(k, params)
+    mode = k.meta["modes"][0]
+    snames = list(k.meta["state_names"][mode])
+    for nm in x_names:
+        if nm not in snames:
+            raise StateError(f"unknown coordinate {nm!r}; known: {', '.join(snames)}")
+    if len(n) != 2 or min(n) < 1 or steps < 1 or check_every < 1 or rows_per_task < 1:
+        raise StateError("need n = (na ≥ 1, nb ≥ 1), steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
+    av = np.linspace(ranges[0][0], ranges[0][1], int(n[0]))
+    bv = np.linspace(ranges[1][0], ranges[1][1], int(n[1]))
+    sweep_values(av, x_names[0]), sweep_values(bv, x_names[1])
+    lc = find_fixed_point(system, params=params)
+    xs = lc.fixed_point
+    base = xs if base_state is None else np.asarray(base_state, float)
+    if base.shape != xs.shape:
+        raise StateError(f"base_state needs {xs.size} values ({', '.join(snames)})")
+    if to_state is None:
+        slope = float(pvec[k.meta["params"].index("slope")]) if "slope" in k.meta["params"] else None
+        to_state = SetCoordinates(snames, x_names, slope)
+    cols = ["i", "j", "a", "b", "outcome", "reason", "steps", "distance"]
+    store = ResultStore(out, cols, ["i", "j", "a", "b"])
+
+    def key(i: int, j: int) -> tuple[str, ...]:
+        return (str(i), str(j), fmt_value(float(av[i])), fmt_value(float(bv[j])))
+
+    store.check_keys([key(i, j) for i in range(len(av)) for j in range(len(bv))])
+    pending = [i for i in range(len(av)) if not all(store.has(key(i, j)) for j in range(len(bv)))]
+    budget_rows = len(pending) if max_points is None else max(0, int(max_points)) // len(bv)
+    pending = pending[:budget_rows]
+    tasks = []
+    for grp in chunks(pending, rows_per_task):
+        tasks.append((system, pvec.tolist(), [(i, float(av[i])) for i in grp], bv.tolist(), base.tolist(),
+                      xs.tolist(), to_state, steps, check_every, tol, rtol, atol))
+    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
+    try:
+        execute(client, _basin_task, tasks, store, progress, len(pending) * len(bv), "basin")
+    finally:
+        close()
+    outcome = np.full((len(av), len(bv)), -1, dtype=int)
+    st = np.zeros((len(av), len(bv)), dtype=int)
+    dist = np.full((len(av), len(bv)), math.nan)
+    why = np.full((len(av), len(bv)), "", dtype=object)
+    complete = True
+    for i in range(len(av)):
+        for j in range(len(bv)):
+            r = store.rows.get(key(i, j))
+            if r is None:
+                complete = False
+                continue
+            outcome[i, j] = BASIN_LABELS.index(r["outcome"])
+            st[i, j] = int(r["steps"])
+            dist[i, j] = float(r["distance"]) if r["distance"] not in ("", "nan") else math.nan
+            why[i, j] = r["reason"]
+    if complete:
+        store.compact()
+    return BasinResult(names=tuple(x_names), a_values=av, b_values=bv, outcome=outcome, steps=st, distance=dist,
+                       fixed_point=xs, path=str(out) if out else None, computed=len(pending) * len(bv),
+                       state_names=snames, reasons=why)
+
+
+__all__ = ["BASIN_LABELS", "BasinResult", "SetCoordinates", "basin"]

@@ -1,0 +1,226 @@
+"""Bifurcation diagrams and Poincaré iterates: where the period-1 gait gives way to period 2, 4...
+
+Along a swept parameter the return map is iterated from the previous value's last post-impact
+state (first put on the new value's section, :func:`on_section`): a transient is dropped, then
+the iterates of one coordinate are kept and their period is read off. Unlike a fixed-point
+branch this follows the *attractor*, so it shows the period-doubling cascade and where the
+walker falls.
+
+Units: angles in rad, angular velocities in rad/s, times in s; parameters in the model's units.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import AmbleError, StateError
+from ..hybrid import HybridSystem
+from ..kernels import CTX_X, build
+from ..simulate import Options, parameter_vector, run
+from .runner import COMPLETED, check_params, chunks, execute, open_client, status_name, sweep_values
+from .store import ResultStore, SweepResult, fmt_value, state_columns, state_from_row
+
+
+def on_section(state_names: Sequence[str], params: Mapping[str, float], x: np.ndarray) -> np.ndarray:
+    """Put a post-impact state of a compass-like walker (coordinates ``stance``, ``swing``,
+    parameter ``slope``) on the section of ``params``: ``swing = 2·slope − stance`` (both feet on
+    the slope, rad). Other systems: ``x`` unchanged."""
+    sn = list(state_names)
+    if "stance" in sn and "swing" in sn and "slope" in params:
+        x = np.array(x, float)
+        x[sn.index("swing")] = 2.0 * float(params["slope"]) - x[sn.index("stance")]
+    return x
+
+
+def _bif_columns(param: str, snames: Sequence[str]) -> list[str]:
+    return ["i", param, "status", "reason", "coordinate", "iterates", "step_times", "period"] + state_columns(snames)
+
+
+def _period(vals: Sequence[float], tol: float) -> int:
+    """Smallest p ≤ len/2 with v[n+p] ≈ v[n] for all n, else 0 (aperiodic / chaotic).
+
+    A period-1 orbit approached slowly (a multiplier near −1 just before the flip) alternates
+    with a shrinking amplitude and would pass as period 2: if the step-to-step differences
+    shrink by half or more over the kept iterates, it is reported as period 1."""
+    v = np.asarray(vals, float)
+    for p in range(1, len(v) // 2 + 1):
+        if np.all(np.abs(v[p:] - v[:-p]) < tol):
+            d = np.abs(np.diff(v))
+            if p > 1 and d.size >= 2 and d[-1] < 0.5 * d[0]:
+                return 1
+            return p
+    return 0
+
+
+def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: list[tuple[int, float]],
+              seed: list[float] | None, coord: int, transient: int, keep: int, rtol: float, atol: float,
+              period_tol: float) -> list[dict[str, Any]]:
+    """Iterate the return map at each value of a chunk, starting from the previous value's last state."""
+    from .poincare import default_guess, find_fixed_point
+
+    k = build(system)
+    mode = k.meta["modes"][0]
+    snames = k.meta["state_names"][mode]
+    mi = k.mode_index(mode)
+    n = k.meta["nx"][mi]
+    opts = Options(rtol=rtol, atol=atol, max_step_time=getattr(system, "max_step_time", 0.0) or 0.0)
+    x = None if seed is None else np.asarray(seed, float)
+    out = []
+    for i, val in points:
+        params = {**base, param: val}
+        p = parameter_vector(k, params)
+        if x is not None:  # the carried state must sit on the section of the new parameters
+            x = on_section(snames, dict(zip(k.meta["params"], p.tolist())), x)
+        row: dict[str, Any] = {"i": i, param: val, "coordinate": snames[coord]}
+        x0 = x
+        if x0 is None:  # no state to carry: start on the period-1 fixed point (it exists past the flip)
+            try:
+                x0 = find_fixed_point(system, params=params, rtol=rtol, atol=atol, tol=1e-9).fixed_point
+            except AmbleError:
+                try:
+                    x0 = np.asarray(default_guess(system, params), float)
+                except AmbleError:
+                    x0 = np.asarray(system.fixed_point_guess or system.default_start[mode], float)
+        st, ctx, _ = run(k, p, mi, x0, steps=transient, opts=opts) if transient > 0 else (COMPLETED, None, None)
+        kept, times, fail = [], [], ""
+        if st != COMPLETED:
+            fail = f"{status_name(k, st, ctx)} during the transient"
+        else:
+            y = x0 if ctx is None else ctx[CTX_X:CTX_X + n].copy()
+            for _ in range(keep):
+                st, ctx, _ = run(k, p, mi, y, steps=1, opts=opts)
+                if st != COMPLETED or int(ctx[1]) != mi:
+                    fail = f"{status_name(k, st, ctx)} after {transient + len(kept)} steps"
+                    break
+                y = ctx[CTX_X:CTX_X + n].copy()
+                kept.append(float(y[coord]))
+                times.append(float(ctx[0]))
+        if fail:
+            row.update(status="failed", reason=fail, iterates=json.dumps(kept), step_times=json.dumps(times),
+                       period="")
+            x = None  # the walker fell: the next value starts from the model's guess again
+        else:
+            row.update(status="ok", reason="", iterates=json.dumps(kept), step_times=json.dumps(times),
+                       period=_period(kept, period_tol))
+            row.update({c: float(v) for c, v in zip(state_columns(snames), y)})
+            x = y
+        out.append(row)
+    return out
+
+
+def bifurcation(
+    system: HybridSystem,
+    param: str,
+    values: Sequence[float],
+    *,
+    params: Mapping[str, float] | None = None,
+    coordinate: str | int = 0,
+    transient: int = 300,
+    keep: int = 64,
+    chunk: int = 16,
+    out: str | os.PathLike | None = None,
+    scheduler: Any = None,
+    workers: int | None = None,
+    progress: bool = True,
+    max_points: int | None = None,
+    rtol: float = 1e-10,
+    atol: float = 1e-10,
+    period_tol: float = 1e-6,
+) -> SweepResult:
+    """Bifurcation diagram: post-transient return-map iterates of one coordinate along ``param``.
+
+    At each value the walker takes ``transient`` steps from the previous value's last
+    post-impact state, then ``keep`` more steps whose post-impact ``coordinate`` (name or state index; default the
+    first, the stance angle of a walker, rad) is kept. A chunk's first value starts on its
+    period-1 fixed point when one is found (else the model's guess walked in); a carried state
+    is first put on the new section (:func:`on_section`). ``period`` in a row: smallest p with
+    iterates repeating within ``period_tol`` (0 = no period found: chaos or slow transient).
+    A value where the walker falls is recorded ``failed`` with the reason.
+    """
+    v = sweep_values(values, param)
+    k = build(system)
+    parameter_vector(k, params)
+    check_params(system, [param])
+    snames = k.meta["state_names"][k.meta["modes"][0]]
+    if isinstance(coordinate, str):
+        if coordinate not in snames:
+            raise StateError(f"unknown coordinate {coordinate!r}; known: {', '.join(snames)}")
+        coord = snames.index(coordinate)
+    else:
+        coord = int(coordinate)
+        if not 0 <= coord < len(snames):
+            raise StateError(f"coordinate index {coord} out of range 0..{len(snames) - 1}")
+    if transient < 0 or keep < 1 or chunk < 1:
+        raise StateError("need transient ≥ 0, keep ≥ 1 and chunk ≥ 1")
+    store = ResultStore(out, _bif_columns(param, snames), ["i", param])
+    keys = [(str(i), fmt_value(float(x))) for i, x in enumerate(v)]
+    store.check_keys(keys)
+    total = sum(1 for key in keys if not store.has(key))
+    budget = total if max_points is None else max(0, min(total, int(max_points)))
+    tasks, n_sched = [], 0
+    for grp in chunks(list(range(len(v))), chunk):
+        pts = [g for g in grp if not store.has(keys[g])]
+        if not pts or n_sched >= budget:
+            continue
+        pts = pts[: budget - n_sched]
+        first = grp.index(pts[0])
+        seed = None
+        if first > 0:  # previous value's last state, exactly as stored
+            r = store.rows.get(keys[grp[first - 1]])
+            x = None if r is None or r["status"] != "ok" else state_from_row(r, snames)
+            seed = None if x is None else x.tolist()
+        tasks.append((system, dict(params or {}), param, [(g, float(v[g])) for g in pts], seed, coord, transient,
+                      keep, rtol, atol, period_tol))
+        n_sched += len(pts)
+    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
+    try:
+        execute(client, _bif_task, tasks, store, progress, n_sched, "bifurcation")
+    finally:
+        close()
+    complete = all(store.has(key) for key in keys)
+    if complete:
+        store.compact()
+    wanted = set(keys)
+    rows = [r for r in store.sorted_rows() if (r["i"], r[param]) in wanted]
+    return SweepResult(kind="bifurcation", params=[param], rows=rows, path=str(out) if out else None,
+                       complete=complete, computed=n_sched, reused=len(keys) - total, state_names=list(snames))
+
+
+def first_period_doubling_iterates(result: SweepResult) -> float | None:
+    """First swept value whose post-transient iterates repeat with a period ≥ 2, or ``None``
+    (period 0 is skipped: near the flip the transient decays too slowly to show a period)."""
+    p = result.params[0]
+    for r in result.rows:
+        if r["status"] == "ok" and r["period"] not in ("", "0", "1"):
+            return float(r[p])
+    return None
+
+
+def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *,
+                      params: Mapping[str, float] | None = None, steps: int = 200, rtol: float = 1e-10,
+                      atol: float = 1e-10) -> np.ndarray:
+    """Successive post-impact states (steps+1 × n; row 0 = x0 or the model's guess); rows after
+    a fall are absent (the array is shorter)."""
+    k = build(system)
+    p = parameter_vector(k, params)
+    mode = k.meta["modes"][0]
+    mi = k.mode_index(mode)
+    n = k.meta["nx"][mi]
+    x = np.asarray(x0 if x0 is not None else (system.fixed_point_guess or system.default_start[mode]), float)
+    opts = Options(rtol=rtol, atol=atol, max_step_time=getattr(system, "max_step_time", 0.0) or 0.0)
+    rows = [x]
+    for _ in range(steps):
+        st, ctx, _ = run(k, p, mi, x, steps=1, opts=opts)
+        if st != COMPLETED:
+            break
+        x = ctx[CTX_X:CTX_X + n].copy()
+        rows.append(x)
+    return np.array(rows)
+
+
+__all__ = ["bifurcation", "first_period_doubling_iterates", "on_section", "poincare_iterates"]

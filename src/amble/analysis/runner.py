@@ -1,0 +1,147 @@
+"""Running sweep work on Dask: clients, chunked tasks, and the names of run outcomes.
+
+Work is cut into *chunks* (a run of consecutive parameter values, one row of a 2D map, one row
+of a basin grid); each chunk is one Dask task, so a task amortises its overhead over many
+return-map evaluations (~20 µs per compass-gait step) instead of one task per point. Chunk
+boundaries depend only on the grid and the chunk size (never on the number of workers), so a
+result does not depend on how many processes computed it. Only the client process writes the
+result file (:class:`~amble.analysis.store.ResultStore`), as each task's rows land.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, StateError
+from ..hybrid import HybridSystem
+from ..kernels import build
+from .store import ResultStore
+
+#: Status codes of :func:`amble.simulate.run` that the sweeps branch on.
+COMPLETED, TERMINAL = 2, 3
+_RUN_STATUS = {1: "end_time", 2: "completed", 3: "terminal", 4: "fell", 5: "zeno", 6: "integrator_failure",
+               7: "integrator_failure", 8: "max_events", 9: "singular_mass", 10: "reset_failed"}
+
+
+class _Serial:
+    """In-process stand-in for a Dask client (``scheduler='synchronous'``): runs tasks on submit."""
+
+    class _Done:
+        def __init__(self, value: Any) -> None:
+            self.value = value
+
+        def result(self) -> Any:
+            return self.value
+
+    def submit(self, fn: Callable, *args: Any, **kw: Any) -> Any:
+        return self._Done(fn(*args, **kw))
+
+    def scatter(self, obj: Any, broadcast: bool = True) -> Any:
+        return obj
+
+    def close(self) -> None:
+        pass
+
+
+def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any, Callable[[], None]]:
+    """A Dask client and its closer.
+
+    ``scheduler``: ``None`` → a :class:`dask.distributed.LocalCluster` of ``workers`` processes
+    (default: CPU count) with one thread each (the compiled integrator holds the GIL);
+    ``"synchronous"`` → run in this process (tests, debugging); a ``distributed.Client`` → used
+    as is; any other string → address of an existing scheduler.
+    """
+    if scheduler == "synchronous":
+        c = _Serial()
+        return c, c.close
+    from dask.distributed import Client, LocalCluster
+
+    if isinstance(scheduler, Client):
+        return scheduler, lambda: None
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as e:
+            raise StateError(f"cannot connect to the Dask scheduler at {scheduler!r} ({e})") from None
+        return client, client.close
+    n = workers or os.cpu_count() or 1
+    if n < 1:
+        raise StateError(f"workers must be at least 1, got {n}")
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
+    client = Client(cluster)
+
+    def close() -> None:
+        client.close()
+        cluster.close()
+
+    return client, close
+
+
+def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, progress: bool, total: int,
+            desc: str) -> None:
+    """Submit ``fn(*task)`` for each task; append each returned row list to the store as it lands.
+
+    Every task's first argument is the same :class:`HybridSystem`."""
+    if not tasks:
+        return
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit="pt", disable=not progress, leave=False)
+    try:
+        if isinstance(client, _Serial):
+            for t in tasks:
+                rows = fn(*t)
+                store.append(rows)
+                bar.update(len(rows))
+            return
+        from dask.distributed import as_completed
+
+        # the system (sympy expressions) is shipped and unpickled once per worker, not once per task
+        shared = client.scatter(tasks[0][0], broadcast=True, hash=False)
+        futures = [client.submit(fn, shared, *t[1:], pure=False) for t in tasks]
+        for fut in as_completed(futures):
+            rows = fut.result()
+            store.append(rows)
+            bar.update(len(rows))
+    finally:
+        bar.close()
+
+
+# ---------------------------------------------------------------------------- grid helpers
+def check_params(system: HybridSystem, names: Sequence[str]) -> None:
+    """Raise :class:`ParameterError` unless every name is a parameter of ``system``."""
+    known = list(build(system).meta["params"])
+    for n in names:
+        if n not in known:
+            raise ParameterError(f"unknown parameter {n!r}; known: {', '.join(known)}")
+
+
+def sweep_values(values: Sequence[float], what: str) -> np.ndarray:
+    """``values`` as a flat float array; refuses an empty or non-finite list (``what`` names it)."""
+    v = np.asarray(values, dtype=float).ravel()
+    if v.size == 0:
+        raise StateError(f"{what}: no values to sweep")
+    if not np.all(np.isfinite(v)):
+        raise StateError(f"{what}: values must be finite")
+    return v
+
+
+def chunks(idx: Sequence[int], size: int) -> list[list[int]]:
+    """``idx`` cut into consecutive runs of ``size`` (the last may be shorter)."""
+    return [list(idx[i:i + size]) for i in range(0, len(idx), size)]
+
+
+def status_name(k: Any, st: int, ctx: np.ndarray) -> str:
+    """Readable outcome of a run: a terminal transition's own status (e.g. ``hip_on_ground``'s
+    ``fell``), else the name of the run status code."""
+    if st == TERMINAL:
+        return str(k.meta["transitions"][int(ctx[10])]["terminal"])
+    return _RUN_STATUS.get(st, "integrator_failure")
+
+
+__all__ = ["COMPLETED", "TERMINAL", "check_params", "chunks", "execute", "open_client", "status_name",
+           "sweep_values"]

@@ -1,0 +1,214 @@
+"""Result store of parameter sweeps: an append-only, resumable CSV journal, and the result table.
+
+Rows go to an **append-only CSV journal** as chunks finish, one ``write`` + ``fsync`` per
+chunk, written by the client process only (single writer, no locks). Why CSV rather than
+Parquet part files: a row is a few hundred bytes that must be durable the moment it exists;
+appending to one text file is atomic enough (a crash leaves at most one torn last line, which
+the reader detects by its field count / missing newline and drops), needs no manifest, and is
+readable by anything. Every row carries its key (grid indices + parameter values written with
+``repr``, which round-trips floats exactly; a file holding points of another grid is refused).
+On reading, the first row of each key wins, so an interrupted sweep run again with the same file
+recomputes only missing keys, duplicates cannot appear, and seeds read back from the file are
+bit-identical to the in-memory ones (the resumed result equals the uninterrupted one byte for
+byte). When every requested point is present the file is *compacted*: sorted by key and
+atomically replaced (temporary file + ``os.replace``). For ``FILE.parquet`` the journal is
+``FILE.parquet.journal.csv``; the Parquet file is written (atomically) at compaction, then the
+journal is removed. Resume with the same options (tolerances, ``chunk``, ``transient``...):
+they are not part of the key.
+
+All values are stored as text exactly as written (:func:`fmt_value`); :class:`SweepResult`
+converts columns back to numbers on demand.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import StateError
+
+
+class ResultStore:
+    """Append-only CSV journal of sweep rows keyed by ``key`` columns (see module docstring).
+
+    ``path``: ``FILE.csv``, ``FILE.parquet`` or ``None`` (rows kept in memory only); existing
+    rows are loaded on construction. ``columns``: every column, in file order; ``key``: the
+    columns that identify a point (first row of a key wins).
+    """
+
+    def __init__(self, path: str | os.PathLike | None, columns: Sequence[str], key: Sequence[str]) -> None:
+        self.columns = list(columns)
+        self.key = list(key)
+        self.final: Path | None = Path(path) if path is not None else None
+        if self.final is not None and self.final.suffix.lower() not in (".csv", ".parquet"):
+            raise StateError(f"result file {str(self.final)!r} must end with .csv or .parquet")
+        self.parquet = self.final is not None and self.final.suffix.lower() == ".parquet"
+        self.journal = (self.final.with_name(self.final.name + ".journal.csv") if self.parquet else self.final)
+        self.rows: dict[tuple[str, ...], dict[str, str]] = {}
+        self._load()
+
+    def _load(self) -> None:
+        if self.final is None:
+            return
+        if self.parquet and self.final.exists() and self.final.stat().st_size > 0:
+            import pyarrow.parquet as pq
+
+            tab = pq.read_table(self.final)
+            if tab.column_names != self.columns:
+                raise StateError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
+            for r in tab.to_pylist():
+                self._add({c: "" if r[c] is None else str(r[c]) for c in self.columns})
+        if self.journal is None or not self.journal.exists() or self.journal.stat().st_size == 0:
+            return
+        data = self.journal.read_bytes()
+        good = data[: data.rfind(b"\n") + 1]  # a torn last line (killed mid-write) is dropped ...
+        if len(good) < len(data):  # ... and cut off, so the next append starts on a fresh line
+            with open(self.journal, "r+b") as f:
+                f.truncate(len(good))
+                os.fsync(f.fileno())
+        lines = good.decode().split("\n")[:-1]
+        reader = csv.reader(lines)
+        header = next(reader, None)
+        if header != self.columns:
+            raise StateError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
+                             "use another file")
+        for fields in reader:
+            if len(fields) == len(self.columns):
+                self._add(dict(zip(self.columns, fields)))
+
+    def _add(self, row: Mapping[str, str]) -> bool:
+        k = tuple(row[c] for c in self.key)
+        if k in self.rows:
+            return False
+        self.rows[k] = dict(row)
+        return True
+
+    def check_keys(self, wanted: Iterable[tuple[str, ...]]) -> None:
+        """Refuse a file holding points outside the requested grid (another sweep's results)."""
+        w = set(wanted)
+        extra = [k for k in self.rows if k not in w]
+        if extra:
+            shown = dict(zip(self.key, extra[0]))
+            raise StateError(f"{str(self.final)!r} holds {len(extra)} point(s) of another sweep (e.g. {shown}); "
+                             "use another file or the same grid")
+
+    def has(self, key: tuple[str, ...]) -> bool:
+        """Whether the point with this key is already stored."""
+        return key in self.rows
+
+    def append(self, rows: Iterable[Mapping[str, Any]]) -> None:
+        """Add rows (values formatted exactly); durable on return when the store has a file."""
+        fresh = []
+        for r in rows:
+            s = {c: fmt_value(r.get(c, "")) for c in self.columns}
+            if self._add(s):
+                fresh.append(s)
+        if self.journal is None or not fresh:
+            return
+        new = not self.journal.exists() or self.journal.stat().st_size == 0
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        if new:
+            w.writerow(self.columns)
+        for s in fresh:
+            w.writerow([s[c] for c in self.columns])
+        with open(self.journal, "a", newline="") as f:
+            f.write(buf.getvalue())
+            f.flush()
+            os.fsync(f.fileno())
+
+    def sorted_rows(self) -> list[dict[str, str]]:
+        """All stored rows, sorted by key."""
+        return [self.rows[k] for k in sorted(self.rows, key=_sort_key)]
+
+    def compact(self) -> None:
+        """Rewrite the file sorted by key, atomically (deterministic content for equal results)."""
+        if self.final is None:
+            return
+        rows = self.sorted_rows()
+        tmp = self.final.with_name(f".{self.final.name}.{os.getpid()}.tmp")
+        if self.parquet:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            pq.write_table(pa.table({c: [r[c] for r in rows] for c in self.columns}), tmp)
+        else:
+            with open(tmp, "w", newline="") as f:
+                w = csv.writer(f, lineterminator="\n")
+                w.writerow(self.columns)
+                for r in rows:
+                    w.writerow([r[c] for c in self.columns])
+                f.flush()
+                os.fsync(f.fileno())
+        os.replace(tmp, self.final)
+        if self.parquet and self.journal is not None and self.journal.exists():
+            self.journal.unlink()
+
+
+def fmt_value(v: Any) -> str:
+    """A cell as text: floats by ``repr`` (round-trips exactly, so a seed read back from the file
+    is bit-identical), booleans ``true``/``false``, ``None`` empty."""
+    if isinstance(v, bool) or v is None:
+        return "" if v is None else str(v).lower()
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    return str(v)
+
+
+def _sort_key(k: tuple[str, ...]) -> tuple:
+    # integer key fields (grid indices) sort numerically, so row 10 follows row 9
+    return tuple(int(x) if x.lstrip("-").isdigit() else x for x in k)
+
+
+def state_columns(names: Sequence[str]) -> list[str]:
+    """Column names ``x_<state>`` of a stored post-impact state."""
+    return [f"x_{n}" for n in names]
+
+
+def state_from_row(row: Mapping[str, str], names: Sequence[str]) -> np.ndarray | None:
+    """The stored state of a row, or ``None`` if it is missing or not finite (a failed point)."""
+    try:
+        x = np.array([float(row[c]) for c in state_columns(names)])
+    except (KeyError, ValueError):
+        return None
+    return x if np.all(np.isfinite(x)) else None
+
+
+@dataclass
+class SweepResult:
+    """Rows of a finished (or partial) sweep, sorted by key; values as written in the file (str)."""
+
+    kind: str
+    params: list[str]
+    rows: list[dict[str, str]]
+    path: str | None
+    complete: bool
+    computed: int
+    reused: int
+    state_names: list[str] = field(default_factory=list)
+
+    def column(self, name: str) -> np.ndarray:
+        """A numeric column (NaN where empty)."""
+        return np.array([float(r[name]) if r[name] not in ("", "nan") else math.nan for r in self.rows])
+
+    def ok(self) -> np.ndarray:
+        """Boolean mask of the rows whose point succeeded."""
+        return np.array([r["status"] == "ok" for r in self.rows])
+
+    def counts(self) -> dict[str, int]:
+        """Number of ``ok`` and ``failed`` rows."""
+        ok = int(self.ok().sum())
+        return {"ok": ok, "failed": len(self.rows) - ok}
+
+
+__all__ = ["ResultStore", "SweepResult", "fmt_value", "state_columns", "state_from_row"]

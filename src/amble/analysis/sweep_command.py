@@ -1,0 +1,184 @@
+"""``amble sweep``: the command-line glue between :mod:`amble.cli` and the sweep functions.
+
+Turns the parsed options into one call of :func:`~amble.analysis.fixed_points.sweep_fixed_points`,
+:func:`~amble.analysis.fixed_points.sweep_fixed_points_2d`,
+:func:`~amble.analysis.bifurcation.bifurcation` or :func:`~amble.analysis.basin.basin`, prints a
+short report (or returns it for ``--json``) and draws the plot. Bad input raises
+:class:`amble.cli.UsageError` (exit code 2) before any work starts.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from .basin import BASIN_LABELS, BasinResult, basin
+from .bifurcation import bifurcation, first_period_doubling_iterates
+from .fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
+
+
+def sweep_cli(args: Any) -> dict[str, Any]:
+    """``amble sweep``: fixed-point branch / map, bifurcation diagram or basin of attraction.
+
+    ``args``: the parsed options of the ``sweep`` sub-command (:func:`amble.cli.build_parser`).
+    Returns the JSON summary (also printed as text unless ``--json``).
+    """
+    from ..cli import UsageError, _load, _writable, parse_sets
+
+    sets = parse_sets(getattr(args, "set", None))
+    basin_kind = args.kind == "basin"
+    ranges = _check_grid(args, basin_kind, UsageError)
+    for nm in ("rtol", "atol"):
+        v = getattr(args, nm, 1e-10)
+        if not (v > 0 and math.isfinite(v)):
+            raise UsageError(f"--{nm} must be a positive number, got {v}")
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers must be at least 1, got {args.workers}")
+    out = _writable(args.out, (".csv", ".parquet"), "--out")
+    if out is not None and out.exists() and out.stat().st_size == 0:
+        out.unlink()  # _writable touched it; an empty file is no journal
+    plot = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    if plot is not None and plot.stat().st_size == 0:
+        plot.unlink()
+    system = _load(args.model)
+    names = [r[0] for r in ranges]
+    if basin_kind:
+        known = list(system.state_names(system.mode_names[0]))
+        for nm in names:
+            if nm not in known:
+                raise UsageError(f"--x: unknown coordinate {nm!r}; known: {', '.join(known)}")
+    else:
+        for nm in names:
+            if nm in sets:
+                raise UsageError(f"parameter {nm!r} is both swept and --set")
+    common = dict(params=sets, out=out, scheduler=args.scheduler, workers=args.workers,
+                  progress=not getattr(args, "json", False), rtol=args.rtol, atol=args.atol)
+    summary: dict[str, Any] = {"model": args.model, "kind": args.kind,
+                               ("coordinates" if basin_kind else "parameters"): names,
+                               "ranges": [list(r[1:]) for r in ranges], "set": sets, "file": str(out) if out else None}
+    t0 = time.perf_counter()
+    res = (_run_basin(system, ranges, args, common, summary) if basin_kind
+           else _run_parameters(system, ranges, args, common, summary))
+    summary["seconds"] = round(time.perf_counter() - t0, 3)
+    if plot is not None:
+        from ..viz import sweep_plots as sp
+
+        if basin_kind:
+            sp.plot_basin(res, plot)
+        elif args.kind == "bifurcation":
+            sp.plot_bifurcation(res, plot)
+        elif len(names) == 1:
+            sp.plot_branch(res, plot)
+        else:
+            sp.plot_parameter_map(res, plot)
+        summary["plot"] = str(plot)
+    if not getattr(args, "json", False):
+        _print(summary, out, plot)
+    return summary
+
+
+def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tuple[str, float, float, int]]:
+    """The grid options of the chosen kind, parsed: ``--param`` ranges, or the two ``--x`` ranges
+    of a basin (with ``--steps``); options of the other kind are refused rather than ignored."""
+    from ..cli import parse_range
+
+    params, xs, steps = args.param or [], getattr(args, "x", None) or [], getattr(args, "steps", None)
+    if basin_kind:
+        if params:
+            raise usage("--kind basin varies initial conditions (--x), not parameters; fix parameters with --set")
+        if len(xs) != 2:
+            raise usage(f"--kind basin needs exactly two --x NAME=START:STOP:COUNT (coordinates of the "
+                        f"post-impact state), got {len(xs)}")
+        if steps is not None and steps < 1:
+            raise usage(f"--steps must be at least 1, got {steps}")
+        ranges = []
+        for text in xs:
+            try:
+                ranges.append(parse_range(text))
+            except usage as e:  # the shared parser names --param; say which option was wrong
+                raise usage(str(e).replace("--param", "--x")) from None
+        if ranges[0][0] == ranges[1][0]:
+            raise usage(f"--x: the two coordinates must differ, got {ranges[0][0]!r} twice")
+        return ranges
+    if xs or steps is not None:
+        raise usage("--x and --steps apply to --kind basin only")
+    if not params:
+        raise usage(f"--kind {args.kind} needs --param NAME=START:STOP:COUNT (once, or twice for a 2D map)")
+    ranges = [parse_range(t) for t in params]
+    if len(ranges) not in (1, 2):
+        raise usage(f"--param: give one (branch) or two (map) parameters, got {len(ranges)}")
+    if args.kind == "bifurcation" and len(ranges) != 1:
+        raise usage("--kind bifurcation sweeps exactly one --param")
+    if len(ranges) == 2 and ranges[0][0] == ranges[1][0]:
+        raise usage(f"--param: the two parameters must differ, got {ranges[0][0]!r} twice")
+    return ranges
+
+
+def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], args: Any, common: dict[str, Any],
+                    summary: dict[str, Any]) -> Any:
+    """Fixed-point branch, 2D map or bifurcation diagram; fills ``summary``, returns the result."""
+    names = [r[0] for r in ranges]
+    vals = [np.linspace(r[1], r[2], r[3]) for r in ranges]
+    if args.kind == "bifurcation":
+        res = bifurcation(system, names[0], vals[0], **common)
+        summary["first_period_two"] = first_period_doubling_iterates(res)
+    elif len(names) == 1:
+        # fixed points and their multipliers need tight tolerances, whatever the default
+        common["rtol"], common["atol"] = min(args.rtol, 1e-12), min(args.atol, 1e-12)
+        res = sweep_fixed_points(system, names[0], vals[0], **common)
+        summary["period_doubling"] = period_doubling(res)
+        st = [r for r in res.rows if r["status"] == "ok" and r["stable"] == "true"]
+        summary["stable_range"] = [float(st[0][names[0]]), float(st[-1][names[0]])] if st else None
+    else:
+        res = sweep_fixed_points_2d(system, (names[0], names[1]), (vals[0], vals[1]), **common)
+        summary["stable"] = sum(1 for r in res.rows if r["stable"] == "true")
+    summary.update(res.counts())
+    summary.update(points=len(res.rows), computed=res.computed, reused=res.reused, complete=res.complete)
+    summary["failures"] = [{**{nm: float(r[nm]) for nm in names}, "reason": r["reason"]}
+                           for r in res.rows if r["status"] != "ok"][:20]
+    return res
+
+
+def _run_basin(system: Any, ranges: list[tuple[str, float, float, int]], args: Any, common: dict[str, Any],
+               summary: dict[str, Any]) -> BasinResult:
+    """Basin of attraction over the two ``--x`` coordinates; fills ``summary``, returns the result."""
+    steps = 60 if args.steps is None else args.steps
+    res = basin(system, (ranges[0][0], ranges[1][0]), ((ranges[0][1], ranges[0][2]), (ranges[1][1], ranges[1][2])),
+                (ranges[0][3], ranges[1][3]), steps=steps, **common)
+    counts = res.counts()
+    cells = res.outcome.size
+    done = int(np.sum(res.outcome >= 0))
+    summary.update(counts)  # per outcome; "ok" below: cells whose walk ran (converged, fell or not)
+    summary.update(steps=steps, fixed_point=res.fixed_point.tolist(), state_names=res.state_names, points=cells,
+                   computed=res.computed, reused=done - res.computed, complete=done == cells,
+                   ok=done - counts["failed"], failed=counts["failed"])
+    a, b = res.names
+    bad = np.argwhere(res.outcome == BASIN_LABELS.index("failed"))[:20]
+    summary["failures"] = [{a: float(res.a_values[i]), b: float(res.b_values[j]), "reason": str(res.reasons[i, j])}
+                           for i, j in bad]
+    return res
+
+
+def _print(summary: dict[str, Any], out: Any, plot: Any) -> None:
+    """The text report of a sweep (the ``--json`` summary in a few lines)."""
+    if summary["kind"] == "basin":
+        over = " × ".join(summary["coordinates"])
+        tally = ", ".join(f"{summary[lab]} {lab}" for lab in BASIN_LABELS)
+        print(f"{summary['model']}: basin over {over}: {summary['points']} initial states, {tally} "
+              f"({summary['seconds']} s)")
+    else:
+        print(f"{summary['model']}: {summary['kind']} sweep over {' × '.join(summary['parameters'])}: "
+              f"{summary['points']} points, {summary['ok']} ok, {summary['failed']} failed ({summary['seconds']} s)")
+    for key in ("period_doubling", "stable_range", "first_period_two"):
+        if key in summary:
+            print(f"  {key.replace('_', ' ')}: {summary[key]}")
+    if out is not None:
+        print(f"  results: {out}")
+    if plot is not None:
+        print(f"  plot: {plot}")
+
+
+__all__ = ["sweep_cli"]
