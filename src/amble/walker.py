@@ -33,11 +33,13 @@ def distance_along_slope(model: Model, point: str, slope: Any) -> sp.Expr:
     return (d.T * model.points[point])[0, 0]
 
 
-def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any]) -> tuple[Guard, Impact]:
+def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any], mirror: str | None = None
+                ) -> tuple[Guard, Impact]:
     """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot,
-    followed by a plastic impact and the leg relabelling."""
+    followed by a plastic impact and the leg relabelling (``mirror="y"`` when the relabelling
+    mirrors the lateral axis, as for a 3D walker whose left and right legs swap roles)."""
     guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > 0)
-    return guard, Impact(foot, relabel)
+    return guard, Impact(foot, relabel, mirror)
 
 
 def joint_lock(constraint: Any, relabel: Mapping[Any, Any] | None = None) -> tuple[Guard, Lock]:
