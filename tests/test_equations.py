@@ -1,6 +1,7 @@
 """Derived equations against hand derivations and the thesis (Eq. 17–19)."""
 
 import sympy as sp
+from chains import pendulum_chain
 
 from amble import Model, derive
 
@@ -77,20 +78,8 @@ def test_energies_written_outright_give_the_same_equations():
     assert sp.simplify(ea.h - ec.h) == sp.zeros(2, 1)
 
 
-def _chain(n):
-    m = Model(f"chain{n}")
-    qs = m.coordinates([f"q{i}" for i in range(n)])
-    ps = m.parameters(**{f"m{i}": 1.0 for i in range(n)}, **{f"l{i}": 1.0 for i in range(n)}, g=9.81)
-    pos = sp.zeros(2, 1)
-    for i in range(n):
-        pos = pos + ps[n + i] * sp.Matrix([sp.sin(qs[i]), -sp.cos(qs[i])])
-        m.point(f"p{i}", pos, mass=ps[i])
-    m.gravity(ps[-1])
-    return m
-
-
 def test_operation_count_grows_polynomially():
-    ops = {n: derive(_chain(n)).count_ops() for n in (3, 6, 12)}
+    ops = {n: derive(pendulum_chain(n)).count_ops() for n in (3, 6, 12)}
     # M has n² entries of O(n) terms: cubic growth at most (doubling n ≤ 8× + slack);
     # SymPy's own LagrangesMethod already needs millions of operations at n = 6.
     assert ops[6] <= 9 * ops[3]

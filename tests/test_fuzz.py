@@ -2,12 +2,12 @@
 bad input only ever raises amble's typed errors."""
 
 import numpy as np
-import sympy as sp
+from chains import pendulum_chain
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import amble
-from amble import HybridSystem, Model
+from amble import HybridSystem
 
 _SYSTEMS: dict[int, HybridSystem] = {}
 
@@ -15,14 +15,7 @@ _SYSTEMS: dict[int, HybridSystem] = {}
 def chain(n: int) -> HybridSystem:
     """An n-link planar pendulum (point masses at link ends, absolute angles), compiled once per n."""
     if n not in _SYSTEMS:
-        m = Model(f"fuzz-chain-{n}")
-        qs = m.coordinates([f"q{i}" for i in range(n)])
-        ps = m.parameters(**{f"m{i}": 1.0 for i in range(n)}, **{f"l{i}": 1.0 for i in range(n)}, g=9.81)
-        pos = sp.zeros(2, 1)
-        for i in range(n):
-            pos = pos + ps[n + i] * sp.Matrix([sp.sin(qs[i]), -sp.cos(qs[i])])
-            m.point(f"p{i}", pos, mass=ps[i])
-        m.gravity(ps[-1])
+        m = pendulum_chain(n, f"fuzz-chain-{n}")
         _SYSTEMS[n] = HybridSystem(m.name, m)
     return _SYSTEMS[n]
 
