@@ -23,6 +23,7 @@ from ..errors import StateError
 from ..hybrid import HybridSystem
 from ..kernels import CTX_X, build
 from ..simulate import Options, parameter_vector, run
+from .bifurcation import on_section
 from .runner import COMPLETED, chunks, execute, open_client, status_name, sweep_values
 from .store import ResultStore, fmt_value
 
@@ -66,18 +67,15 @@ class SetCoordinates:
     """
 
     def __init__(self, state_names: Sequence[str], names: tuple[str, str], slope: float | None) -> None:
-        self.idx = [list(state_names).index(n) for n in names]
-        sn = list(state_names)
-        self.pair = (sn.index("stance"), sn.index("swing")) if (
-            slope is not None and "stance" in sn and "swing" in sn and "swing" not in names) else None
-        self.slope = slope
+        self.state_names = list(state_names)
+        self.idx = [self.state_names.index(n) for n in names]
+        # the section rule is enforced unless swing itself is one of the varied coordinates
+        self.section = {"slope": slope} if slope is not None and "swing" not in names else {}
 
     def __call__(self, a: float, b: float, base: np.ndarray) -> np.ndarray:
         x = base.copy()
         x[self.idx[0]], x[self.idx[1]] = a, b
-        if self.pair is not None:
-            x[self.pair[1]] = 2.0 * self.slope - x[self.pair[0]]
-        return x
+        return on_section(self.state_names, self.section, x)
 
 
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
