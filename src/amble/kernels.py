@@ -163,8 +163,9 @@ class Kernels:
         if ctx_x != CTX_X:
             raise CompileError("compiled model and loader disagree on the context layout; clear the cache")
         lib.amble_simulate.restype = ctypes.c_int
-        lib.amble_simulate.argtypes = [_dptr, _dptr, _dptr, _lptr, _dptr, _iptr, _dptr, _lptr,
-                                       _dptr, _iptr, _dptr, _dptr, _lptr]
+        # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
+        # evaluation, and building typed ctypes pointers costs more than a walking step.
+        lib.amble_simulate.argtypes = [ctypes.c_void_p] * 13
         lib.amble_rhs.restype = ctypes.c_int
         lib.amble_rhs.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         lib.amble_guards.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]

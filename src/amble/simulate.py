@@ -137,13 +137,9 @@ class _Buffers:
         self.ne = np.zeros(1, dtype=np.int64)
 
     def call(self, k: Kernels, p, ctx, opt, iopt) -> int:
-        import ctypes
-
-        d = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-        i = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_int))
-        li = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_long))
-        return int(k.simulate_raw(d(p), d(ctx), d(opt), li(iopt), d(self.t), i(self.mode), d(self.x), li(self.n),
-                                  d(self.et), i(self.etr), d(self.epre), d(self.epost), li(self.ne)))
+        arrays = (p, ctx, opt, iopt, self.t, self.mode, self.x, self.n, self.et, self.etr, self.epre, self.epost,
+                  self.ne)
+        return int(k.simulate_raw(*[a.ctypes.data for a in arrays]))
 
     def grow(self) -> None:
         if self.cap == 0 and self.ecap == 0:
