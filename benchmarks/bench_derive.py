@@ -7,7 +7,7 @@ gravity ``g`` along −z. Masses, lengths and ``g`` are run-time parameters on b
 amble side, in a fresh interpreter with an empty ``AMBLE_CACHE_DIR`` (a cold cache):
 ``amble`` and its code generator are imported first (not timed, as the peer imports SymPy before
 its clock starts); then the Model is written, wrapped in a :class:`amble.HybridSystem` with no
-transitions and built with :func:`amble.kernels.build` — which runs :func:`amble.derive`, generates
+transitions and built with :func:`amble.backend.kernels.build` — which runs :func:`amble.derive`, generates
 the C source and compiles it into a shared library. The total is that whole sequence; the
 breakdown (derive / code generation / C compile) comes from timing wrappers put around the three
 internal calls. ``ops`` is :meth:`amble.Equations.count_ops` (M, h, Γ with common subexpressions
@@ -84,8 +84,8 @@ def build_chain(n: int) -> Any:
 def worker(n: int, check: bool) -> dict[str, Any]:
     """Time the cold build of the n-link chain in this (fresh) process; optionally check q̈."""
     import amble
-    import amble.codegen as codegen
-    import amble.kernels as kernels
+    import amble.backend.codegen as codegen
+    import amble.backend.kernels as kernels
 
     spans: dict[str, float] = {"derive_s": 0.0, "generate_s": 0.0, "compile_s": 0.0}
     captured: list[Any] = []
@@ -132,7 +132,7 @@ def check_qdd(k: Any, n: int, seed: int = 0) -> dict[str, float]:
     """Relative q̈ differences: amble vs the peer's lambdified equations and vs Newton–Euler."""
     import numpy as np
 
-    from amble.simulate import parameter_vector
+    from amble.simulation.simulate import parameter_vector
     from benchmarks.peers import sympy_chain
 
     rng = np.random.default_rng(seed)
@@ -245,7 +245,7 @@ def run(quick: bool = False) -> Section:
         "Cold derive + code generation + C compile of an n-link planar pendulum chain (point masses at "
         "the link ends, absolute angles, all masses/lengths/g as run-time parameters). Each amble run is "
         "a fresh Python process with an empty `AMBLE_CACHE_DIR`; *total* = writing the Model + "
-        "`amble.kernels.build` (derive, codegen, `cc -O2` compile, load), imports excluded on both sides. "
+        "`amble.backend.kernels.build` (derive, codegen, `cc -O2` compile, load), imports excluded on both sides. "
         + reps_note
         + "SymPy peer: `LagrangesMethod` + `lambdify(cse=True)` in a fresh process per n, one run each, "
         f"stopped at the first n past {peer_limit:.0f} s. Ops: arithmetic operations with common "

@@ -38,7 +38,7 @@ def amble_executable() -> list[str]:
     found = shutil.which("amble")
     if found:
         return [found]
-    return [sys.executable, "-c", "import sys; from amble.cli import main; sys.exit(main())"]
+    return [sys.executable, "-c", "import sys; from amble.cli.main import main; sys.exit(main())"]
 
 
 def _wall(cmd: list[str], env: dict[str, str]) -> float:
@@ -57,7 +57,7 @@ def _import_profile(cmd_args: list[str], env: dict[str, str], top: int = 12) -> 
     Modules nested up to two levels deep are listed, so the heavy dependencies pulled in by
     ``amble`` show up beside ``amble`` itself.
     """
-    code = "import sys; from amble.cli import main; sys.exit(main(sys.argv[1:]))"
+    code = "import sys; from amble.cli.main import main; sys.exit(main(sys.argv[1:]))"
     proc = subprocess.run([sys.executable, "-X", "importtime", "-c", code, *cmd_args], env=env,
                           capture_output=True, text=True)
     rows = []
@@ -74,7 +74,7 @@ _PROFILE_CODE = """
 import cProfile, contextlib, io, pstats, sys
 prof = cProfile.Profile()
 prof.enable()
-from amble.cli import main
+from amble.cli.main import main
 with contextlib.redirect_stdout(io.StringIO()):
     main(sys.argv[1:])
 prof.disable()

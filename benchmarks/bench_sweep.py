@@ -17,7 +17,7 @@ import time
 
 
 def _warm(system) -> None:
-    from amble.kernels import build
+    from amble.backend.kernels import build
 
     build(system)
 
@@ -48,7 +48,7 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=60, help="footfalls per cell at most (default 60)")
     args = ap.parse_args()
     from amble.analysis.sweep import basin
-    from amble.kernels import build
+    from amble.backend.kernels import build
     from amble.models import load
 
     system = load("compass-gait")

@@ -6,7 +6,7 @@ order: stance, swing, stance_dot, swing_dot) with Drake's default parameters (m_
 m = 5 kg, a = b = 0.5 m, g = 9.81 m/s², slope 0.0525 rad; amble's compass-gait default slope is
 0.05, so ``slope=0.0525`` is passed).
 
-* amble fast path: ``amble.simulate.run(k, p, 0, x0, steps=N, opts=Options(rtol=tol, atol=tol))``
+* amble fast path: ``amble.simulation.simulate.run(k, p, 0, x0, steps=N, opts=Options(rtol=tol, atol=tol))``
   — the whole walk (integration, event location, resets) in one compiled call; timed around the
   Python call (kernels already built, one warm-up call).
 * ``amble.simulate(...)``: the user-facing call that also records the sampled trajectory.
@@ -43,9 +43,9 @@ GOAL_FLOOR_RATIO = 3.0
 
 def _amble_setup() -> tuple[Any, Any, Any]:
     """(system, kernels, parameter vector) of the compass gait with Drake's slope."""
-    from amble.kernels import build
+    from amble.backend.kernels import build
     from amble.models import load
-    from amble.simulate import parameter_vector
+    from amble.simulation.simulate import parameter_vector
 
     system = load("compass-gait")
     k = build(system)
@@ -54,8 +54,8 @@ def _amble_setup() -> tuple[Any, Any, Any]:
 
 def amble_walk(k: Any, p: np.ndarray, x0: np.ndarray, steps: int, tol: float) -> tuple[int, np.ndarray]:
     """Walk ``steps`` steps on amble's fast path; returns (status code, final post-impact state)."""
-    from amble.kernels import CTX_X
-    from amble.simulate import Options, run
+    from amble.backend.kernels import CTX_X
+    from amble.simulation.simulate import Options, run
 
     st, ctx, _ = run(k, p, 0, x0, steps=steps, opts=Options(rtol=tol, atol=tol))
     return st, ctx[CTX_X:CTX_X + 4].copy()

@@ -6,8 +6,8 @@ into the current directory.
 
 from amble import simulate
 from amble.models import load
-from amble.viz.animate import animate
-from amble.viz.plot import plot_trajectory
+from amble.viz import animate
+from amble.viz import plot_trajectory
 
 walker = load("compass-gait")
 # Start near the thesis' gait (state: stance, swing, stance_dot, swing_dot in rad, rad/s).
@@ -18,5 +18,5 @@ print("footfalls at t =", ", ".join(f"{e.t:.4f}" for e in walk.step_events[:5]),
 print("post-impact state:", walk.final_post_impact_state)
 
 plot_trajectory(walk, "compass_walk.png")  # angles and energies over time, footfalls marked
-animate(walker, walk, "compass_walk.html")  # open in a browser; works offline
+animate(walk, "compass_walk.html")  # open in a browser; works offline
 print("wrote compass_walk.png and compass_walk.html")

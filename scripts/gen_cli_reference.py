@@ -16,7 +16,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from amble.cli import EXAMPLES, build_parser
+from amble.cli.main import EXAMPLES, build_parser
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGET = ROOT / "docs" / "cli.md"

@@ -29,11 +29,11 @@ def main() -> None:
         for name in ROBOTS:
             system = load(name)
             walk = amble.simulate(system, steps=4, sample_dt=0.005)
-            html = walk.animate(Path(d) / f"{name}.html")
+            html = amble.animate(walk, Path(d) / f"{name}.html")
             t = float(walk.step_events[2].t) - 0.03  # just before a heel strike: legs spread
             screenshot(html, OUT / f"{name}.png", t=t, view="iso" if name == "humanoid-3d" else "side")
     cycle = find_fixed_point(load("compass-gait"))
-    cycle.plot(OUT / "compass-gait-limit-cycle.png")
+    amble.plot_limit_cycle(cycle, OUT / "compass-gait-limit-cycle.png")
 
 
 if __name__ == "__main__":

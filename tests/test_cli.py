@@ -7,7 +7,7 @@ import sys
 import pytest
 import sympy as sp
 
-from amble.cli import main
+from amble.cli.main import main
 
 
 def run(capsys, *args):

@@ -32,7 +32,7 @@ def test_cli_reference_is_current():
 
 
 def test_cli_reference_lists_every_command_and_option():
-    from amble.cli import build_parser
+    from amble.cli.main import build_parser
 
     text = (DOCS / "cli.md").read_text(encoding="utf-8")
     for action in build_parser()._actions:

@@ -45,7 +45,7 @@ def test_random_chains_conserve_energy(n, masses, lengths, state):
     "--out", "/nonexistent/x.csv", "x.txt", "--param", "slope=0.1:0.01:3", "slope=a:b:c", "--rtol", "inf",
 ]), max_size=6))
 def test_cli_never_crashes(args):
-    from amble.cli import main
+    from amble.cli.main import main
 
     code = main(args)
     assert code in (0, 2)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from amble.kernels import build
-from amble.simulate import parameter_vector
+from amble.backend.kernels import build
+from amble.simulation.simulate import parameter_vector
 
 
 def goswami_impact(q, qd, m, mh, a, b):

@@ -121,7 +121,7 @@ def test_singular_mass_matrix_is_reported():
 
 
 def test_changing_a_default_is_seen_without_recompiling():
-    from amble.kernels import build
+    from amble.backend.kernels import build
 
     def system(g):
         m = _falling_mass()

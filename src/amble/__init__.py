@@ -4,9 +4,7 @@ Write coordinates, positions, masses and energies; amble derives the equations o
 impact maps, compiles them, simulates with exact events, and finds limit cycles.
 """
 
-__version__ = "0.1.0"
-
-from .equations import Equations, derive
+from .derivation.equations import Equations, derive
 from .errors import (
     AmbleError,
     CompileError,
@@ -16,15 +14,19 @@ from .errors import (
     SimulationError,
     StateError,
 )
-from .hybrid import Explicit, Guard, HybridSystem, Impact, Lock
-from .model import R3, Model, R, t, vector
-from .simulate import Options, simulate
-from .trajectory import Event, Trajectory
-from .walker import distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
+from .modelling.geometry import R3, R, t, vector
+from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
+from .modelling.model import Model
+from .modelling.walker import Walker, distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
+from .simulation.simulate import Options, simulate
+from .simulation.trajectory import Event, Trajectory
+from .version import __version__  # noqa: F401  (amble.__version__)
+from .viz import animate, plot_limit_cycle, plot_trajectory
 
 __all__ = [
     "AmbleError", "CompileError", "ConvergenceError", "Equations", "Event", "Explicit", "Guard",
     "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "ParameterError", "R", "R3",
-    "SimulationError", "StateError", "Trajectory", "derive", "distance_along_slope", "heel_strike",
-    "height_above_slope", "joint_lock", "simulate", "t", "vector", "walker",
+    "SimulationError", "StateError", "Trajectory", "Walker", "animate", "derive", "distance_along_slope",
+    "heel_strike", "height_above_slope", "joint_lock", "plot_limit_cycle", "plot_trajectory", "simulate", "t",
+    "vector", "walker",
 ]

@@ -27,7 +27,7 @@ from amble.analysis.sweep import (
     sweep_fixed_points,
     sweep_fixed_points_2d,
 )
-from amble.cli import main
+from amble.cli.main import main
 
 SYNC = {"scheduler": "synchronous", "progress": False}
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from amble.cli import main
+from amble.cli.main import main
 
 #: 13 slopes × 8 hip masses; one Dask task (one journal append) per slope, continuation along mh.
 GRID = ["--param", "slope=0:0.06:13", "--param", "mh=8:12:8"]
@@ -68,7 +68,7 @@ def _keys(path: Path) -> list[tuple[str, str]]:
 
 
 def test_killed_sweep_resumes_to_the_uninterrupted_file(compass, tmp_path, capsys):
-    from amble.kernels import build
+    from amble.backend.kernels import build
 
     build(compass)  # compile once here, so the subprocesses only load it from the cache
     ref = tmp_path / "uninterrupted.csv"
@@ -101,7 +101,7 @@ def test_killed_sweep_resumes_to_the_uninterrupted_file(compass, tmp_path, capsy
 @pytest.mark.slow
 def test_killed_basin_resumes_to_the_uninterrupted_file(compass, tmp_path, capsys):
     """The same for a basin of attraction written to Parquet (journal beside the final file)."""
-    from amble.kernels import build
+    from amble.backend.kernels import build
 
     build(compass)
     cmd = ["sweep", "compass-gait", "--kind", "basin", "--x", "stance=-0.3:-0.15:60", "--x",

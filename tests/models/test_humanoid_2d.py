@@ -5,9 +5,9 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.kernels import build
+from amble.backend.kernels import build
 from amble.models import load
-from amble.simulate import parameter_vector
+from amble.simulation.simulate import parameter_vector
 
 
 @pytest.fixture(scope="module")

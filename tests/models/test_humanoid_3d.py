@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from amble import simulate
-from amble.kernels import build
+from amble.backend.kernels import build
 from amble.models import load
-from amble.simulate import parameter_vector
+from amble.simulation.simulate import parameter_vector
 
 MIRROR = np.array([-1.0, 1.0, -1.0])  # angular momentum (a pseudovector) under the y → −y relabel
 

@@ -5,9 +5,9 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.kernels import build
+from amble.backend.kernels import build
 from amble.models import load
-from amble.simulate import parameter_vector
+from amble.simulation.simulate import parameter_vector
 
 #: Hsu Chen (2007) Table 3.1 parameters; the slope of Tedrake's kneedCompassGait.m, asin(7.25/144) = 0.0503685 rad
 #: (the thesis prints 0.0504), which is the slope of her published fixed point (docs/references.md, 3a).

@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.kernels import CTX_X, build
 from ..errors import StateError
-from ..hybrid import HybridSystem
-from ..kernels import CTX_X, build
-from ..simulate import Options, parameter_vector, run
+from ..modelling.hybrid import HybridSystem
+from ..simulation.simulate import Options, parameter_vector, run
 from .bifurcation import on_section
 from .runner import COMPLETED, chunks, execute, open_client, status_name, sweep_values
 from .store import ResultStore, fmt_value
@@ -88,7 +88,7 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     p = np.asarray(pvec, float)
     xs = np.asarray(fixed, float)
     b0 = np.asarray(base, float)
-    opts = Options(rtol=rtol, atol=atol, max_step_time=getattr(system, "max_step_time", 0.0) or 0.0)
+    opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
     out = []
     for i, a in rows:
         for j, b in enumerate(b_values):

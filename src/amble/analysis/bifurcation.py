@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.kernels import CTX_X, build
 from ..errors import AmbleError, StateError
-from ..hybrid import HybridSystem
-from ..kernels import CTX_X, build
-from ..simulate import Options, parameter_vector, run
+from ..modelling.hybrid import HybridSystem
+from ..simulation.simulate import Options, parameter_vector, run
 from .runner import COMPLETED, check_params, chunks, execute, open_client, status_name, sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns, state_from_row
 
@@ -68,7 +68,7 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
     snames = k.meta["state_names"][mode]
     mi = k.mode_index(mode)
     n = k.meta["nx"][mi]
-    opts = Options(rtol=rtol, atol=atol, max_step_time=getattr(system, "max_step_time", 0.0) or 0.0)
+    opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
     x = None if seed is None else np.asarray(seed, float)
     out = []
     for i, val in points:
@@ -212,7 +212,7 @@ def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *
     mi = k.mode_index(mode)
     n = k.meta["nx"][mi]
     x = np.asarray(x0 if x0 is not None else (system.fixed_point_guess or system.default_start[mode]), float)
-    opts = Options(rtol=rtol, atol=atol, max_step_time=getattr(system, "max_step_time", 0.0) or 0.0)
+    opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
     rows = [x]
     for _ in range(steps):
         st, ctx, _ = run(k, p, mi, x, steps=1, opts=opts)

@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.kernels import build
 from ..errors import AmbleError, StateError
-from ..hybrid import HybridSystem
-from ..kernels import build
-from ..simulate import parameter_vector
+from ..modelling.hybrid import HybridSystem
+from ..simulation.simulate import parameter_vector
 from .runner import check_params, chunks, execute, open_client, sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns, state_from_row
 

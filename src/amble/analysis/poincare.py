@@ -21,10 +21,10 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.kernels import CTX_X, Kernels, build
 from ..errors import ConvergenceError, SimulationError, StateError
-from ..hybrid import HybridSystem
-from ..kernels import CTX_X, Kernels, build
-from ..simulate import Options, initial_state, parameter_vector, run, simulate
+from ..modelling.hybrid import HybridSystem
+from ..simulation.simulate import Options, initial_state, parameter_vector, run, simulate
 
 
 @dataclass
@@ -49,23 +49,6 @@ class LimitCycle:
         """Simulate the gait from the fixed point (default: two periods), samples every 5 ms."""
         return simulate(self.hybrid_system, self.fixed_point, params=self.parameters,
                         steps=steps or 2 * self.period, sample_dt=0.005)
-
-    def plot(self, path: Any = None) -> Any:
-        """Phase portrait of the cycle with its impact jumps (thesis Figures 8, 10, 12)."""
-        from ..viz.plot import plot_limit_cycle
-
-        return plot_limit_cycle(self.trajectory(), path, cycle=self)
-
-    def _repr_png_(self) -> bytes:
-        import io
-
-        import matplotlib.pyplot as plt
-
-        fig = self.plot()
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=90)
-        plt.close(fig)
-        return buf.getvalue()
 
     @property
     def stable(self) -> bool:
@@ -108,7 +91,7 @@ class ReturnMap:
         self.period = period
         self.mode = mode or self.k.meta["modes"][0]
         self.mi = self.k.mode_index(self.mode)
-        mst = getattr(system, "max_step_time", 0.0) or 0.0
+        mst = system.max_step_time
         self.opts = Options(rtol=rtol, atol=atol, max_step_time=mst)
         self.n = self.k.meta["nx"][self.mi]
 

@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.kernels import build
 from ..errors import ParameterError, StateError
-from ..hybrid import HybridSystem
-from ..kernels import build
+from ..modelling.hybrid import HybridSystem
 from .store import ResultStore
 
 #: Status codes of :func:`amble.simulate.run` that the sweeps branch on.

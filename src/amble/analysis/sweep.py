@@ -10,7 +10,6 @@ This module gathers the public API of the sweep feature; each idea lives in its 
 - :mod:`amble.analysis.bifurcation` — bifurcation diagrams, :func:`poincare_iterates`,
   :func:`on_section`;
 - :mod:`amble.analysis.basin` — basins of attraction;
-- :mod:`amble.analysis.sweep_command` — ``amble sweep`` (:func:`sweep_cli`).
 
 Work is cut into chunks (consecutive parameter values, one row of a map or a basin), each one
 Dask task; chunks depend only on the grid, so a result does not depend on how many processes
@@ -30,8 +29,7 @@ from .bifurcation import bifurcation, first_period_doubling_iterates, on_section
 from .fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from .runner import open_client
 from .store import ResultStore, SweepResult
-from .sweep_command import sweep_cli
 
 __all__ = ["BASIN_LABELS", "BasinResult", "ResultStore", "SetCoordinates", "SweepResult", "basin", "bifurcation",
-           "first_period_doubling_iterates", "open_client", "period_doubling", "poincare_iterates", "sweep_cli",
-           "sweep_fixed_points", "sweep_fixed_points_2d", "on_section"]
+           "first_period_doubling_iterates", "on_section", "open_client", "period_doubling", "poincare_iterates",
+           "sweep_fixed_points", "sweep_fixed_points_2d"]

@@ -8,7 +8,7 @@ import pkgutil
 from functools import cache, lru_cache
 
 from ..errors import ModelError
-from ..hybrid import HybridSystem
+from ..modelling.hybrid import HybridSystem
 
 
 @lru_cache(maxsize=1)

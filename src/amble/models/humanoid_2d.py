@@ -29,13 +29,13 @@ x* with torso (0.03, 0.05): not comparable, see kneed-biped.)
 
 import sympy as sp
 
-from amble import HybridSystem, R
+from amble import R, Walker
 from amble.models.kneed_biped import kneed_model, kneed_walker
 
 NAME = "humanoid-2d"
 
 
-def build() -> HybridSystem:
+def build() -> Walker:
     m = kneed_model(NAME, "torso")
     st, sh, th, tr = m.q
     mT, lT, kT, kv, theta_d, kleg = m.parameters(mT=3.0, lT=0.5, kT=100.0, kv=10.0, theta_d=0.0, kleg=5.0)

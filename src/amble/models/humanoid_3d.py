@@ -45,12 +45,9 @@ pair; its eigenvector lies mostly in torso, torso_cor, yaw and stance rates), 0.
 humanoid-2d gait with the coronal angles and yaw at zero converges to x*.
 """
 
-import dataclasses
-
 import sympy as sp
 
-from amble import R3, Guard, HybridSystem, Model, distance_along_slope
-from amble.walker import heel_strike, height_above_slope
+from amble import R3, Model, Walker, distance_along_slope, walker
 
 NAME = "humanoid-3d"
 
@@ -72,7 +69,7 @@ def upper_body_frame(torso, torso_cor, yaw):
     return _rot_y(torso) * _rot_x(-torso_cor) * _rot_z(yaw)
 
 
-def build() -> HybridSystem:
+def build() -> Walker:
     m = Model(NAME, dims=3)
     st, sw, st_c, sw_c, tor, tor_c, yaw = m.coordinates("stance swing stance_cor swing_cor torso torso_cor yaw")
     mh, ml, mt, a, b, lt, w, g, slope, i_xy, i_z = m.parameters(
@@ -98,15 +95,11 @@ def build() -> HybridSystem:
     m.force([0, tau_leg, -k_sc * st_c - kv_sc * dot(st_c), -k_sw * sw_c - kv_sw * dot(sw_c),
              k_t * (th_d - tor) - kv_t * dot(tor), -k_tc * tor_c - kv_tc * dot(tor_c), -k_y * yaw - kv_y * dot(yaw)])
     relabel = {st: sw, sw: st, st_c: -sw_c, sw_c: -st_c, tor: tor, tor_c: -tor_c, yaw: -yaw}
-    s = HybridSystem(NAME, {NAME: m}, ground_slope=slope, hip="hip", doc=__doc__)
-    guard, impact = heel_strike(m, "swing_foot", slope, relabel)
-    s.transition("heel_strike", NAME, guard, dataclasses.replace(impact, mirror="y"), step=True)
-    s.terminal("hip_on_ground", NAME, Guard(height_above_slope(m, "hip", slope), -1), status="fell")
     # the stable period-1 fixed point (post-impact; step 0.7597 s, |multipliers| ≤ 0.531)
-    s.default_start[NAME] = s.fixed_point_guess = [
+    x_star = [
         -0.17513872545372786, 0.21584692131603855, -0.0027109889560943323, -0.0007943995955461281,
         -0.026276535422660098, -0.11538290987512972, -0.005241697963894061, 0.824737150927434,
         0.6092596999815059, -0.08939453002223806, -0.12489102822875123, 0.1031354286921594,
         0.4242854569830537, -0.35175036643091706]
-    s.max_step_time = 5.0
-    return s
+    return walker(m, foot="swing_foot", hip="hip", slope=slope, relabel=relabel, start=x_star, mirror="y",
+                  doc=__doc__)

@@ -42,7 +42,7 @@ signs (angles counter-clockwise) at best, and lies on no heel-strike section of 
 (stance + swing would be ∓0.1): it cannot be compared beyond its signs.
 """
 
-from amble import Guard, HybridSystem, Model, R, heel_strike, height_above_slope, joint_lock
+from amble import Guard, Model, R, Walker, heel_strike, height_above_slope, joint_lock
 
 NAME = "kneed-biped"
 
@@ -67,12 +67,12 @@ def kneed_model(name: str, extra: str = "") -> Model:
     return m
 
 
-def kneed_walker(m: Model, doc: str) -> HybridSystem:
+def kneed_walker(m: Model, doc: str) -> Walker:
     """Modes "unlocked" and "locked" (knee straight: shank = thigh), the knee lock (Eq. 27–28),
     heel strike with the relabelling of Eq. 29, a bent-knee footfall ("scuffed") and falls."""
     (st, sh, th, *_), slope = m.q, m.symbol("slope")
     locked = m.constrained(f"{m.name}-locked", {sh: th})
-    s = HybridSystem(m.name, {"unlocked": m, "locked": locked}, ground_slope=slope, hip="hip", doc=doc)
+    s = Walker(m.name, {"unlocked": m, "locked": locked}, hip="hip", slope=slope, doc=doc)
     s.transition("knee_lock", "unlocked", *joint_lock(sh - th), "locked")
     s.transition("heel_strike", "locked", *heel_strike(locked, "swing_foot", slope, {st: th, sh: st, th: st}),
                  "unlocked", step=True)
@@ -81,7 +81,7 @@ def kneed_walker(m: Model, doc: str) -> HybridSystem:
     return s
 
 
-def build() -> HybridSystem:
+def build() -> Walker:
     s = kneed_walker(kneed_model(NAME), __doc__)
     # the stable limit cycle at the defaults (post-impact state; step 0.7327 s, |multipliers| 0.697, 0.697, 0.077)
     s.default_start["unlocked"] = s.fixed_point_guess = [-0.2224446318, 0.3224446318, 0.3224446318, 1.098070999,

@@ -71,8 +71,7 @@ import math
 
 import sympy as sp
 
-from amble import Explicit, Guard, HybridSystem, Model, R, height_above_slope
-from amble.viz import Cylinder, Sphere
+from amble import Explicit, Guard, Model, R, Walker, height_above_slope
 
 NAME = "simplest-walker"
 
@@ -86,15 +85,16 @@ def _on_cycle(theta: float, theta_dot: float) -> list[float]:
     return [theta, 2.0 * theta, theta_dot, (1.0 - math.cos(2.0 * theta)) * theta_dot]
 
 
-def build() -> HybridSystem:
-    m = Model("simplest-walker")
+def build() -> Walker:
+    m = Model("simplest-walker", time_unit="√(l/g)")
     th, ph = m.coordinates("theta phi")
     thd, phd = m.dot(th), m.dot(ph)
     slope = m.parameter("slope", 0.009, "ramp angle γ (rad), descending along +x")
 
-    # Drawing points in amble's frame: leg angles from the true vertical, positive downhill.
+    # Points in amble's frame: leg angles from the true vertical, positive downhill. The hip
+    # carries the unit mass M (scaled), which is what K and V below say; the feet's β → 0.
     m.point("stance_foot", (0, 0))
-    hip = m.point("hip", R(slope - th), link="stance_foot")
+    hip = m.point("hip", R(slope - th), mass=1, link="stance_foot")
     m.point("swing_foot", hip - R(slope - th + ph), link="hip")
 
     # The hip is a Lagrangian inverted pendulum; the swing leg has unit inertia and is driven
@@ -107,7 +107,8 @@ def build() -> HybridSystem:
     c = sp.cos(2 * th)
     reset = Explicit(q={th: -th, ph: -2 * th}, qd={thd: c * thd, phd: c * (1 - c) * thd}, shift="swing_foot")
 
-    sys_ = HybridSystem(m.name, {m.name: m}, ground_slope=slope, hip="hip", doc=__doc__)
+    sys_ = Walker(m.name, {m.name: m}, max_step_time=20.0, hip="hip", slope=slope,  # a step: ≈ 3.8 time units
+                  doc=__doc__)
     # phi − 2 theta rises through zero at heel strike (theta < 0); its downward crossing near
     # mid-stance is the ignored foot scuffing.
     sys_.transition("heel_strike", m.name, Guard(ph - 2 * th, +1, th < 0), reset, step=True)
@@ -115,12 +116,4 @@ def build() -> HybridSystem:
     start = _on_cycle(THETA_STAR, THETA_DOT_STAR)
     sys_.default_start[m.name] = start
     sys_.fixed_point_guess = list(start)
-    sys_.max_step_time = 20.0  # scaled time; a step takes about 3.8
-    sys_.look = [
-        Cylinder(between=("stance_foot", "hip"), radius=0.015),
-        Cylinder(between=("hip", "swing_foot"), radius=0.015),
-        Sphere(at="hip", radius=0.08),
-        Sphere(at="stance_foot", radius=0.02, color=(0.25, 0.27, 0.30)),
-        Sphere(at="swing_foot", radius=0.02, color=(0.25, 0.27, 0.30)),
-    ]
     return sys_

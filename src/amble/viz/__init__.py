@@ -1,6 +1,11 @@
-"""Visualisation: matplotlib plots, a 3D scene API (Sphere / Cylinder / Box / Ground) and an
-offline browser animation."""
+"""Visualisation: matplotlib plots, a 3D scene API (Sphere / Cylinder / Box / Ground), an
+offline browser animation, and rich display in notebooks."""
 
+from .animate import animate
+from .notebook import register as _register_notebook
+from .plot import plot_limit_cycle, plot_trajectory
 from .scene import Box, Cylinder, Ground, Sphere, default_look
 
-__all__ = ["Box", "Cylinder", "Ground", "Sphere", "default_look"]
+_register_notebook()
+
+__all__ = ["Box", "Cylinder", "Ground", "Sphere", "animate", "default_look", "plot_limit_cycle", "plot_trajectory"]

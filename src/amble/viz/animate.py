@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -9,16 +10,18 @@ from typing import Any
 import numpy as np
 
 from ..errors import AmbleError
-from ..hybrid import HybridSystem
-from ..trajectory import Trajectory
+from ..modelling.hybrid import HybridSystem
+from ..modelling.walker import Walker
+from ..simulation.trajectory import Trajectory
 from .scene import Ground, Sphere, default_look, frames
 
 
-def look_of(system: HybridSystem, params: dict[str, float]) -> list[Any]:
-    """The system's declared look, or a default one from its masses, links and slope."""
+def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] | None = None) -> list[Any]:
+    """The shapes that draw a system: ``look`` if given (with the walker's ground added), else a
+    default from its masses, links and slope."""
     slope = _slope(system, params)
-    if system.look:
-        shapes = list(system.look)
+    if look:
+        shapes = list(look)
         if not any(isinstance(s, Ground) for s in shapes):
             shapes.insert(0, Ground(slope=slope))
         return shapes
@@ -41,19 +44,17 @@ def look_of(system: HybridSystem, params: dict[str, float]) -> list[Any]:
 
 
 def _slope(system: HybridSystem, params: dict[str, float]) -> float:
-    s = system.ground_slope
-    try:
-        return float(params.get(str(s), s)) if not isinstance(s, (int, float)) else float(s)
-    except (TypeError, ValueError):
-        return 0.0
+    return system.slope_value(params) if isinstance(system, Walker) else 0.0
 
 
-def scene_of(system: HybridSystem, traj: Trajectory, fps: float = 60.0) -> dict:
+def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = None) -> dict:
     """Scene JSON (see :func:`amble.viz.scene.frames`) of a trajectory in world coordinates."""
+    system = traj.system
     times, pts = traj.resample(fps)
-    shapes = look_of(system, traj.parameters)
+    shapes = look_of(system, traj.parameters, look)
     step_idx = np.searchsorted([e.t for e in traj.step_events], times, side="right")
-    follow = system.hip if system.hip in pts else None
+    hip = system.hip if isinstance(system, Walker) else None
+    follow = hip if hip in pts else None
     used = {n for s in shapes for n in _names(s)}
     pts = {n: np.nan_to_num(v) for n, v in pts.items() if n in used or n == follow}
     return frames(shapes, pts, times, follow=follow, labels={"step": step_idx.tolist()})
@@ -69,21 +70,24 @@ def _names(shape: Any) -> list[str]:
     return out
 
 
-def animate(system: HybridSystem, traj: Trajectory, path: str | Path, fps: float = 60.0) -> Path:
-    """Write an animation of ``traj``: ``.html`` (3D, offline, interactive), ``.gif`` or ``.mp4``."""
+def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None) -> Path:
+    """Write an animation of ``traj``: ``.html`` (3D, offline, interactive), ``.gif`` or ``.mp4``.
+
+    ``look``: the shapes to draw (:mod:`amble.viz.scene`); default: made from the model."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".html":
         from .html import write_html
 
-        return write_html(path, scene_of(system, traj, fps), title=f"amble — {system.name}")
+        return write_html(path, scene_of(traj, fps, look), title=f"amble — {traj.system.name}")
     if suffix in (".gif", ".mp4"):
-        return _movie(system, traj, path, fps=min(fps, 30.0))
+        return _movie(traj, path, fps=min(fps, 30.0), look=look)
     raise AmbleError(f"unknown animation format {path.suffix!r}: use .html, .gif or .mp4")
 
 
-def _movie(system: HybridSystem, traj: Trajectory, path: Path, fps: float) -> Path:
+def _movie(traj: Trajectory, path: Path, fps: float, look: Sequence[Any] | None) -> Path:
     """Side view (x–z) for 2D models; side and front views for 3D ones."""
+    system = traj.system
     import matplotlib
 
     matplotlib.use("Agg")
@@ -91,7 +95,7 @@ def _movie(system: HybridSystem, traj: Trajectory, path: Path, fps: float) -> Pa
     from matplotlib.animation import FuncAnimation, PillowWriter
 
     times, pts = traj.resample(fps)
-    shapes = look_of(system, traj.parameters)
+    shapes = look_of(system, traj.parameters, look)
     views = [(0, 2, "side (x–z)")] + ([(1, 2, "front (y–z)")] if system.dims == 3 else [])
     fig, axes = plt.subplots(1, len(views), figsize=(5 * len(views), 4), squeeze=False)
     allp = np.concatenate([np.nan_to_num(v) for v in pts.values()])

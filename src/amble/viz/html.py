@@ -29,7 +29,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from amble.viz.scene import FORMAT
+from .scene import FORMAT
 
 __all__ = ["render_html", "write_html"]
 

@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from ..trajectory import Trajectory
+from ..analysis.poincare import LimitCycle
+from ..simulation.trajectory import Trajectory
 
 
 def _plt():
@@ -21,8 +22,17 @@ def _plt():
     return plt
 
 
-def _unit(name: str) -> str:
-    return "rad/s" if name.endswith("_dot") else "rad"
+_QUANTITY = {"rad": "angle", "rad/s": "angular velocity", "m": "position", "m/s": "velocity", "s": "time",
+             "J": "energy"}
+
+
+def _label(traj: Trajectory, names: Sequence[str], fallback: str) -> str:
+    """Axis label from the declared units of the plotted columns: ``angle [rad]`` when they share
+    one unit, ``fallback [m, rad]`` when they mix."""
+    units = sorted({traj.unit(n) for n in names} - {""})
+    if len(units) == 1:
+        return f"{_QUANTITY.get(units[0], fallback)} [{units[0]}]"
+    return f"{fallback} [{', '.join(units)}]" if units else fallback
 
 
 def plot_trajectory(traj: Trajectory, path: str | Path | None = None, variables: Sequence[str] | None = None) -> Any:
@@ -35,23 +45,27 @@ def plot_trajectory(traj: Trajectory, path: str | Path | None = None, variables:
     for e in traj.step_events:
         for ax in axes:
             ax.axvline(e.t, color="0.85", lw=0.8, zorder=0)
-    axes[0].set_ylabel("angle [rad]")
+    axes[0].set_ylabel(_label(traj, names, "coordinate"))
     axes[0].legend(loc="upper right", fontsize=8)
     energy = traj.energy()
     axes[1].plot(traj.t, energy[:, 0], label="kinetic")
     axes[1].plot(traj.t, energy[:, 1] - energy[0, 1], label="potential (rel.)")
     axes[1].plot(traj.t, energy.sum(axis=1) - energy[0, 1], label="total (rel.)", color="k", lw=1)
-    axes[1].set_ylabel("energy [J]")
-    axes[1].set_xlabel("time [s]")
+    axes[1].set_ylabel(_label(traj, ["kinetic_energy"], "energy"))
+    axes[1].set_xlabel(_label(traj, ["t"], "time"))
     axes[1].legend(loc="upper right", fontsize=8)
     axes[0].set_title(f"{traj.kernels.meta['name']}: {traj.status}, {traj.steps} steps")
     fig.tight_layout()
     return _finish(fig, path)
 
 
-def plot_limit_cycle(traj: Trajectory, path: str | Path | None = None, cycle: Any = None) -> Any:
-    """Phase portrait (angle vs angular velocity) of each coordinate over the last step(s),
-    with the impact jumps drawn as arrows (thesis Figures 8, 10, 12)."""
+def plot_limit_cycle(traj: Trajectory | LimitCycle, path: str | Path | None = None,
+                     cycle: LimitCycle | None = None) -> Any:
+    """Phase portrait (coordinate vs its rate) of each coordinate over the last step(s), with the
+    impact jumps drawn as arrows (thesis Figures 8, 10, 12). Given a :class:`LimitCycle`, its
+    gait is simulated over two periods and the fixed point marked."""
+    if isinstance(traj, LimitCycle):
+        traj, cycle = traj.trajectory(), traj
     plt = _plt()
     steps = traj.step_events
     t0 = steps[-2].t if len(steps) >= 2 else traj.t[0]
@@ -76,9 +90,10 @@ def plot_limit_cycle(traj: Trajectory, path: str | Path | None = None, cycle: An
         fp = dict(zip(cycle.state_names, cycle.fixed_point))
         ax.plot([fp[n] for n in coords], [fp[n + "_dot"] for n in coords], "k*", ms=9, label="fixed point")
         mods = ", ".join(f"{abs(m):.3f}" for m in cycle.multipliers)
-        ax.set_title(f"{cycle.system}: step {cycle.step_time:.4f} s, |multipliers| {mods}", fontsize=9)
-    ax.set_xlabel("angle [rad]")
-    ax.set_ylabel("angular velocity [rad/s]")
+        ax.set_title(f"{cycle.system}: step {cycle.step_time:.4f} {traj.unit('t')}, |multipliers| {mods}",
+                     fontsize=9)
+    ax.set_xlabel(_label(traj, coords, "coordinate"))
+    ax.set_ylabel(_label(traj, [n + "_dot" for n in coords], "rate"))
     ax.axhline(0, color="0.85", lw=0.8, zorder=0)
     ax.legend(fontsize=8)
     fig.tight_layout()

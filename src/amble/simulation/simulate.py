@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ParameterError, StateError
-from .hybrid import HybridSystem
-from .kernels import CTX_X, Kernels, build
+from ..backend.kernels import CTX_X, Kernels, build
+from ..errors import ParameterError, StateError
+from ..modelling.hybrid import HybridSystem
 from .trajectory import Event, Trajectory
 
 _STATUS = {
@@ -209,7 +209,7 @@ def simulate(
         if not (v > 0 and math.isfinite(v)):
             raise StateError(f"{name} must be a positive number, got {v}")
     base = options or Options()
-    mst = max_step_time if max_step_time is not None else getattr(system, "max_step_time", 0.0) or 0.0
+    mst = max_step_time if max_step_time is not None else system.max_step_time
     opts = Options(rtol=rtol, atol=atol, max_step=base.max_step, max_step_time=mst, zeno_dt=base.zeno_dt,
                    zeno_events=base.zeno_events, max_events=base.max_events, nsub=base.nsub)
     st, ctx, rec = run(k, p, mi, x, t_end=t_end if t_end is not None else math.inf, steps=steps or 0,

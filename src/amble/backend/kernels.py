@@ -27,11 +27,11 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from . import __version__
-from .errors import CompileError, ModelError
-from .hybrid import HybridSystem
+from ..errors import CompileError, ModelError
+from ..modelling.hybrid import HybridSystem
+from ..version import __version__
 
-_C_DIR = Path(str(resources.files("amble") / "_c"))
+_C_DIR = Path(str(resources.files("amble.backend") / "_c"))
 _LOADED: dict[str, Kernels] = {}
 
 _dptr = ctypes.POINTER(ctypes.c_double)
@@ -56,7 +56,7 @@ def structure_key(system: HybridSystem) -> str:
         if f.suffix in (".c", ".h"):
             h.update(f.read_bytes())
     h.update(Path(__file__).with_name("codegen.py").read_bytes())
-    h.update(Path(__file__).with_name("equations.py").read_bytes())
+    h.update((Path(__file__).parents[1] / "derivation" / "equations.py").read_bytes())
     for name, m in system.modes.items():
         parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]
         parts += [m._k_terms, m._v_terms, m._k_override, m._v_override, m._l_override]

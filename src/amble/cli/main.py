@@ -8,91 +8,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
-from .errors import AmbleError
-
-
-class UsageError(AmbleError):
-    """Bad command-line input."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # one line, exit 2, no usage dump
-        raise UsageError(message)
-
-
-def _float(text: str, what: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise UsageError(f"{what}: {text!r} is not a number") from None
-    if not math.isfinite(v):
-        raise UsageError(f"{what}: {text!r} is not finite")
-    return v
-
-
-def parse_sets(items: Sequence[str] | None) -> dict[str, float]:
-    """``NAME=VALUE`` pairs → dict (values must be finite numbers)."""
-    out: dict[str, float] = {}
-    for item in items or []:
-        name, eq, val = item.partition("=")
-        if not eq or not name.strip():
-            raise UsageError(f"--set expects NAME=VALUE, got {item!r}")
-        out[name.strip()] = _float(val.strip(), f"--set {name.strip()}")
-    return out
-
-
-def parse_range(text: str) -> tuple[str, float, float, int]:
-    """``NAME=START:STOP:COUNT`` → (name, start, stop, count)."""
-    name, eq, rng = text.partition("=")
-    parts = rng.split(":")
-    if not eq or not name.strip() or len(parts) != 3:
-        raise UsageError(f"--param expects NAME=START:STOP:COUNT, got {text!r}")
-    start, stop = _float(parts[0], "range start"), _float(parts[1], "range stop")
-    try:
-        count = int(parts[2])
-    except ValueError:
-        raise UsageError(f"range count {parts[2]!r} is not an integer") from None
-    if count < 1:
-        raise UsageError(f"range count must be at least 1, got {count}")
-    if count > 1 and start == stop:
-        raise UsageError(f"empty range {start}:{stop} with {count} points")
-    if start > stop:
-        raise UsageError(f"reversed range {start}:{stop}: give START below STOP")
-    return name.strip(), start, stop, count
-
-
-def _writable(path: str | None, suffixes: Sequence[str], what: str) -> Path | None:
-    if path is None:
-        return None
-    p = Path(path)
-    if p.suffix.lower() not in suffixes:
-        raise UsageError(f"{what}: {path!r} must end with one of {', '.join(suffixes)}")
-    parent = p.parent if str(p.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"{what}: directory {str(parent)!r} does not exist")
-    try:
-        with open(p, "a"):
-            pass
-    except OSError as e:
-        raise UsageError(f"{what}: cannot write {path!r} ({e.strerror})") from None
-    return p
-
-
-def _load(name: str):
-    from .models import load
-
-    return load(name)
+from ..errors import AmbleError
+from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 
 
 # ---------------------------------------------------------------------- commands
 def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
-    from .models import load, names
+    from ..models import load, names
 
     rows = []
     for name in names():
@@ -109,9 +35,9 @@ def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
 def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
     import sympy as sp
 
-    from .equations import derive
+    from ..derivation.equations import derive
 
-    s = _load(args.model)
+    s = load_model(args.model)
     out: dict[str, Any] = {"model": args.model, "modes": {}}
     for mname, m in s.modes.items():
         eq = derive(m)
@@ -164,7 +90,7 @@ def _start(s, text: str | None, params: dict[str, float]):
     if text is None:
         return None
     if text == "fixed-point":
-        from .analysis.poincare import find_fixed_point
+        from ..analysis.poincare import find_fixed_point
 
         return find_fixed_point(s, params=params).fixed_point
     if text.startswith("x0="):
@@ -174,16 +100,16 @@ def _start(s, text: str | None, params: dict[str, float]):
 
 
 def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
-    from .simulate import simulate
+    from ..simulation.simulate import simulate
 
-    out_p = _writable(args.out, (".csv", ".parquet", ".npz"), "--out")
-    plot_p = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    anim_p = _writable(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    out_p = writable_path(args.out, (".csv", ".parquet", ".npz"), "--out")
+    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
     if args.steps is not None and args.steps < 1:
         raise UsageError(f"--steps must be at least 1, got {args.steps}")
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
-    s = _load(args.model)
+    s = load_model(args.model)
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
@@ -194,14 +120,14 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         tr.save(out_p)
         summary["out"] = str(out_p)
     if plot_p:
-        from .viz.plot import plot_trajectory
+        from ..viz.plot import plot_trajectory
 
         plot_trajectory(tr, plot_p)
         summary["plot"] = str(plot_p)
     if anim_p:
-        from .viz.animate import animate
+        from ..viz.animate import animate
 
-        animate(s, tr, anim_p)
+        animate(tr, anim_p)
         summary["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {tr.status} — {tr.message}")
@@ -215,31 +141,31 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
-    from .analysis.poincare import find_fixed_point
+    from ..analysis.poincare import find_fixed_point
 
-    plot_p = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    anim_p = _writable(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
     if args.period < 1:
         raise UsageError(f"--period must be at least 1, got {args.period}")
-    s = _load(args.model)
+    s = load_model(args.model)
     params = parse_sets(args.set)
     guess = _start(s, args.guess, params) if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
     out = lc.to_json()
     if plot_p or anim_p:
-        from .simulate import simulate
+        from ..simulation.simulate import simulate
 
         tr = simulate(s, lc.fixed_point, params=params, steps=max(args.period, 2) if plot_p and not anim_p else 12,
                       rtol=args.rtol, atol=args.atol, sample_dt=1.0 / 200)
         if plot_p:
-            from .viz.plot import plot_limit_cycle
+            from ..viz.plot import plot_limit_cycle
 
             plot_limit_cycle(tr, plot_p, cycle=lc)
             out["plot"] = str(plot_p)
         if anim_p:
-            from .viz.animate import animate
+            from ..viz.animate import animate
 
-            animate(s, tr, anim_p)
+            animate(tr, anim_p)
             out["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
@@ -254,7 +180,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
 
 def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
     # options are checked (UsageError, exit 2) in sweep_cli before any file is touched or work starts
-    from .analysis.sweep import sweep_cli
+    from .sweep import sweep_cli
 
     return sweep_cli(args)
 
@@ -336,7 +262,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _version() -> str:
-    from . import __version__
+    from ..version import __version__
 
     return __version__
 

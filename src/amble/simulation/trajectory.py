@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import AmbleError
+from ..errors import AmbleError
 
 if TYPE_CHECKING:
-    from .kernels import Kernels
+    from ..backend.kernels import Kernels
 
 
 @dataclass
@@ -98,8 +98,10 @@ class Trajectory:
         return {n: pos[:, i, :] for i, n in enumerate(self.kernels.meta["points"])}
 
     def world_points(self) -> dict[str, np.ndarray]:
-        """Point positions in the world frame: each footfall moves the origin to the new foothold
-        (and reflects the lateral axis when the impact's relabelling mirrors it)."""
+        """Point positions in the world frame: each transition's frame change
+        (:meth:`HybridSystem.frame_change <amble.modelling.hybrid.HybridSystem.frame_change>`)
+        accumulates — a footfall moves the origin to the new foothold (and a walker whose legs
+        swap sides reflects the lateral axis)."""
         if self._world is None:
             pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
             origins, frames = self._frames_per_row(pos)
@@ -109,8 +111,8 @@ class Trajectory:
 
     def _frames_per_row(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         meta = self.kernels.meta
-        info = {tr["name"]: tr for tr in meta["transitions"]}
         pidx = {n: i for i, n in enumerate(meta["points"])}
+        changes = {tr["name"]: self.system.frame_change(tr["name"]) for tr in meta["transitions"]}
         origin, frame = np.zeros(3), np.eye(3)
         origins, frames = np.zeros((len(self.t), 3)), np.zeros((len(self.t), 3, 3))
         ev_iter = iter(self.events)
@@ -120,11 +122,10 @@ class Trajectory:
             origins[i], frames[i] = origin, frame
             # an event writes a pre row then a post row at the same time
             if ev is not None and i + 1 < n and self.t[i] == ev.t and self.t[i + 1] == ev.t:
-                tr = info.get(ev.name, {})
-                if tr.get("shift") is not None:
-                    origin = origin + frame @ pos[i, pidx[tr["shift"]]]
-                if tr.get("mirror") == "y":
-                    frame = frame @ np.diag([1.0, -1.0, 1.0])
+                shift, flip = changes[ev.name]
+                if shift is not None:
+                    origin = origin + frame @ pos[i, pidx[shift]]
+                frame = frame @ np.diag(flip)
                 ev = next(ev_iter, None)
         return origins, frames
 
@@ -148,6 +149,14 @@ class Trajectory:
             out[name] = np.where(np.isfinite(interp), interp, a)
         return times, out
 
+    def unit(self, name: str) -> str:
+        """Unit of a column of :meth:`table` (``""`` for ``mode`` and undeclared names)."""
+        if name == "t":
+            return self.system.time_unit if self.system is not None else "s"
+        if name in ("kinetic_energy", "potential_energy"):
+            return "J" if self.system is None or self.system.time_unit == "s" else ""
+        return self.system.unit(name) if self.system is not None else ""
+
     def table(self) -> dict[str, np.ndarray]:
         """Columns: ``t``, ``mode``, then every state variable of every mode (NaN where absent)."""
         cols: dict[str, np.ndarray] = {"t": self.t, "mode": np.array([self.mode_names[m] for m in self.mode])}
@@ -160,55 +169,38 @@ class Trajectory:
         return cols
 
     def save(self, path: str | Path) -> Path:
-        """Write the samples to ``.csv``, ``.parquet`` or ``.npz`` (chosen by suffix)."""
+        """Write the samples to ``.csv``, ``.parquet`` or ``.npz`` (chosen by suffix).
+
+        Units travel with the columns: CSV headers read ``name [unit]``, Parquet fields carry a
+        ``unit`` metadata entry, an ``.npz`` holds ``units`` (one per column, in order)."""
         path = Path(path)
         cols = self.table()
+        units = [self.unit(c) for c in cols]
         suffix = path.suffix.lower()
         if suffix == ".npz":
             ev = {
                 "event_t": np.array([e.t for e in self.events]),
                 "event_name": np.array([e.name for e in self.events]),
             }
-            np.savez(path, **cols, **ev)
+            np.savez(path, **cols, **ev, columns=np.array(list(cols)), units=np.array(units))
         elif suffix == ".csv":
             import csv
 
             with path.open("w", newline="") as f:
                 wr = csv.writer(f)
-                wr.writerow(list(cols))
+                wr.writerow([f"{c} [{u}]" if u else c for c, u in zip(cols, units)])
                 for row in zip(*cols.values()):
                     wr.writerow([v if isinstance(v, str) else repr(float(v)) for v in row])
         elif suffix == ".parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq
 
-            pq.write_table(pa.table({k: pa.array(v) for k, v in cols.items()}), path)
+            fields = [pa.field(k, pa.array(v).type, metadata={"unit": u} if u else None)
+                      for (k, v), u in zip(cols.items(), units)]
+            pq.write_table(pa.table({k: pa.array(v) for k, v in cols.items()}, schema=pa.schema(fields)), path)
         else:
             raise AmbleError(f"unknown output format {path.suffix!r}: use .csv, .parquet or .npz")
         return path
-
-    def animate(self, path: str | Path, fps: float = 60.0) -> Path:
-        """Write an animation: ``.html`` (interactive 3D, offline), ``.gif`` or ``.mp4``."""
-        from .viz.animate import animate
-
-        return animate(self.system, self, path, fps=fps)
-
-    def plot(self, path: str | Path | None = None, variables: list[str] | None = None) -> Any:
-        """Time series of the coordinates and the energies (a matplotlib figure, or a file)."""
-        from .viz.plot import plot_trajectory
-
-        return plot_trajectory(self, path, variables)
-
-    def _repr_html_(self) -> str:
-        """In Jupyter a trajectory shows itself as the interactive 3D viewer."""
-        import html as _html
-
-        from .viz.animate import scene_of
-        from .viz.html import render_html
-
-        page = render_html(scene_of(self.system, self, fps=30.0), title=f"amble — {self.kernels.meta['name']}")
-        return (f'<iframe srcdoc="{_html.escape(page)}" style="width:100%;height:480px;border:0" '
-                'sandbox="allow-scripts"></iframe>')
 
     def summary(self) -> dict[str, Any]:
         """JSON-friendly summary of the run (the CLI's ``--json`` output)."""

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from .errors import ModelError
-from .model import Model, t
+from ..errors import ModelError
+from ..modelling.model import Model, t
 
 
 @dataclass
@@ -80,6 +80,10 @@ class Equations:
         g = sp.latex(self.Gamma.subs(names))
         body = f"{m}\\,{qdd} + {h} = {g}"
         return f"$${body}$$" if display else body
+
+    def _repr_latex_(self) -> str:
+        """Jupyter shows ``derive(model)`` as the typeset equations."""
+        return self.latex(display=True)
 
 
 def _latex_name(name: str) -> str:

@@ -15,9 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from .basin import BASIN_LABELS, BasinResult, basin
-from .bifurcation import bifurcation, first_period_doubling_iterates
-from .fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
+from ..analysis.basin import BASIN_LABELS, BasinResult, basin
+from ..analysis.bifurcation import bifurcation, first_period_doubling_iterates
+from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
+from .args import UsageError, load_model, parse_range, parse_sets, writable_path
 
 
 def sweep_cli(args: Any) -> dict[str, Any]:
@@ -26,8 +27,6 @@ def sweep_cli(args: Any) -> dict[str, Any]:
     ``args``: the parsed options of the ``sweep`` sub-command (:func:`amble.cli.build_parser`).
     Returns the JSON summary (also printed as text unless ``--json``).
     """
-    from ..cli import UsageError, _load, _writable, parse_sets
-
     sets = parse_sets(getattr(args, "set", None))
     basin_kind = args.kind == "basin"
     ranges = _check_grid(args, basin_kind, UsageError)
@@ -37,13 +36,13 @@ def sweep_cli(args: Any) -> dict[str, Any]:
             raise UsageError(f"--{nm} must be a positive number, got {v}")
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be at least 1, got {args.workers}")
-    out = _writable(args.out, (".csv", ".parquet"), "--out")
+    out = writable_path(args.out, (".csv", ".parquet"), "--out")
     if out is not None and out.exists() and out.stat().st_size == 0:
         out.unlink()  # _writable touched it; an empty file is no journal
-    plot = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    plot = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     if plot is not None and plot.stat().st_size == 0:
         plot.unlink()
-    system = _load(args.model)
+    system = load_model(args.model)
     names = [r[0] for r in ranges]
     if basin_kind:
         known = list(system.state_names(system.mode_names[0]))
@@ -83,8 +82,6 @@ def sweep_cli(args: Any) -> dict[str, Any]:
 def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tuple[str, float, float, int]]:
     """The grid options of the chosen kind, parsed: ``--param`` ranges, or the two ``--x`` ranges
     of a basin (with ``--steps``); options of the other kind are refused rather than ignored."""
-    from ..cli import parse_range
-
     params, xs, steps = args.param or [], getattr(args, "x", None) or [], getattr(args, "steps", None)
     if basin_kind:
         if params:

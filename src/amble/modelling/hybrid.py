@@ -1,6 +1,6 @@
 """Hybrid systems: modes, guards (witness functions) and resets, kept apart.
 
-A :class:`HybridSystem` is a set of modes — each a :class:`~amble.model.Model` with its own
+A :class:`HybridSystem` is a set of modes — each a :class:`~amble.modelling.model.Model` with its own
 coordinates — and transitions between them. A transition has
 
 * a :class:`Guard`: a witness function ``g(q, q̇, t)`` of the source mode; the transition fires
@@ -26,7 +26,7 @@ from typing import Any
 
 import sympy as sp
 
-from .errors import ModelError
+from ..errors import ModelError
 from .model import Model
 
 
@@ -71,9 +71,6 @@ class Impact(Reset):
 
     point: str
     relabel: Mapping[Any, Any]
-    #: ``"y"`` when the relabelling mirrors the lateral axis (a 3D walker whose left and right
-    #: legs swap roles); drawing code then reflects the world frame at every such footfall.
-    mirror: str | None = None
 
     @property
     def shift_point(self) -> str:  # type: ignore[override]
@@ -126,18 +123,21 @@ class HybridSystem:
     """Modes and transitions of a hybrid mechanical system.
 
     ``modes`` maps a mode name to its model (a single :class:`Model` makes one mode named after
-    it). The first mode is the default initial mode. ``ground_slope`` (a parameter symbol or a
-    number, radians) tells drawing code where the walking surface is.
+    it). The first mode is the default initial mode.
+
+    Declared, optional: ``default_start`` (mode name → full initial state, used when a run is
+    given none), ``fixed_point_guess`` (a post-transition state where periodic-orbit searches
+    start) and ``max_step_time`` (s; a run with no ``step`` transition for this long ends as
+    ``fell``; 0 = no limit). Walker notions (hip, slope, mirrored legs) live in
+    :class:`amble.modelling.walker.Walker`.
     """
 
     name: str
     modes: dict[str, Model]
     transitions: list[Transition] = field(default_factory=list)
-    ground_slope: Any = 0.0
     default_start: dict[str, Sequence[float]] = field(default_factory=dict)
     fixed_point_guess: Sequence[float] | None = None
-    hip: str | None = None
-    look: list[Any] = field(default_factory=list)
+    max_step_time: float = 0.0
     doc: str = ""
 
     def __post_init__(self) -> None:
@@ -148,6 +148,8 @@ class HybridSystem:
         dims = {m.dims for m in self.modes.values()}
         if len(dims) != 1:
             raise ModelError(f"system {self.name!r}: modes mix 2D and 3D models")
+        if not (self.max_step_time >= 0):
+            raise ModelError(f"system {self.name!r}: max_step_time must be ≥ 0 s, got {self.max_step_time!r}")
         _ = self.parameters  # validates consistent defaults
 
     # ------------------------------------------------------------------ declaring
@@ -211,6 +213,31 @@ class HybridSystem:
                     )
                 out[k] = v
         return out
+
+    @property
+    def time_unit(self) -> str:
+        return next(iter(self.modes.values())).time_unit
+
+    def unit(self, name: str) -> str:
+        """Unit of a state variable or parameter by name, as its mode declares it (``""`` if none)."""
+        for m in self.modes.values():
+            u = m.unit(name)
+            if u:
+                return u
+        return ""
+
+    def frame_change(self, transition: str) -> tuple[str | None, tuple[float, float, float]]:
+        """How a transition re-expresses positions: the point whose pre-event position becomes the
+        new origin (or ``None``) and the diagonal of the axis reflection (world-frame kinematics
+        accumulate these over a run)."""
+        tr = self._transition(transition)
+        return (tr.reset.shift_point if tr.reset is not None else None), (1.0, 1.0, 1.0)
+
+    def _transition(self, name: str) -> Transition:
+        for tr in self.transitions:
+            if tr.name == name:
+                return tr
+        raise ModelError(f"system {self.name!r}: no transition named {name!r}")
 
     def state_names(self, mode: str | None = None) -> list[str]:
         """State names of a mode (default: the first): coordinates, then velocities."""

@@ -9,12 +9,53 @@ A point's height above the ground is ``n·p``; it is ahead of the stance foot wh
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import sympy as sp
 
+from ..errors import ModelError
 from .hybrid import Guard, HybridSystem, Impact, Lock
 from .model import Model
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+@dataclass
+class Walker(HybridSystem):
+    """A hybrid system that walks on a slope: what analysis and drawing need beyond modes and
+    transitions.
+
+    ``hip``: the point a camera follows and whose fall ends a run; ``slope``: the ground's
+    angle (a parameter symbol or a number, rad; the surface descends along +x through each
+    step's stance foot); ``mirror``: ``"y"`` when the relabelling at a footfall mirrors the
+    lateral axis (a 3D walker whose left and right legs swap roles), so world-frame kinematics
+    reflect that axis at every ``step`` transition.
+    """
+
+    hip: str | None = None
+    slope: Any = 0.0
+    mirror: str | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.mirror is not None and self.mirror not in _AXES:
+            raise ModelError(f"walker {self.name!r}: mirror must be one of x, y, z or None, got {self.mirror!r}")
+        if self.hip is not None and self.hip not in self.point_names:
+            raise ModelError(f"walker {self.name!r}: hip {self.hip!r} is not a point of the model")
+
+    def frame_change(self, transition: str) -> tuple[str | None, tuple[float, float, float]]:
+        shift, flip = super().frame_change(transition)
+        if self.mirror is not None and self._transition(transition).step:
+            flip = tuple(-f if i == _AXES[self.mirror] else f for i, f in enumerate(flip))  # type: ignore[assignment]
+        return shift, flip
+
+    def slope_value(self, params: Mapping[str, float]) -> float:
+        """The ground angle (rad) at these parameter values (a parameter name resolved in them)."""
+        s = self.slope
+        if isinstance(s, (int, float)):
+            return float(s)
+        return float(params.get(str(s), self.parameters.get(str(s), 0.0)))
 
 
 def _vec2(model: Model, a: Any, b: Any) -> sp.Matrix:
@@ -33,13 +74,11 @@ def distance_along_slope(model: Model, point: str, slope: Any) -> sp.Expr:
     return (d.T * model.points[point])[0, 0]
 
 
-def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any], mirror: str | None = None
-                ) -> tuple[Guard, Impact]:
+def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any]) -> tuple[Guard, Impact]:
     """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot,
-    followed by a plastic impact and the leg relabelling (``mirror="y"`` when the relabelling
-    mirrors the lateral axis, as for a 3D walker whose left and right legs swap roles)."""
+    followed by a plastic impact and the leg relabelling."""
     guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > 0)
-    return guard, Impact(foot, relabel, mirror)
+    return guard, Impact(foot, relabel)
 
 
 def joint_lock(constraint: Any, relabel: Mapping[Any, Any] | None = None) -> tuple[Guard, Lock]:
@@ -59,20 +98,21 @@ def walker(
     start: Sequence[float] | None = None,
     guess: Sequence[float] | None = None,
     max_step_time: float = 5.0,
+    mirror: str | None = None,
     doc: str = "",
-) -> HybridSystem:
+) -> Walker:
     """A one-mode walker: heel strike of ``foot`` on the slope (a step) and a fall of ``hip``.
 
     ``start`` is the default initial state, ``guess`` the default fixed-point guess (both in
     ``model.state_names`` order). A walker that makes no footfall for ``max_step_time`` seconds,
-    or whose hip reaches the ground, has fallen.
+    or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`.
     """
-    sys_ = HybridSystem(model.name, {model.name: model}, ground_slope=slope, hip=hip, doc=doc)
+    sys_ = Walker(model.name, {model.name: model}, max_step_time=max_step_time, hip=hip, slope=slope,
+                  mirror=mirror, doc=doc)
     guard, reset = heel_strike(model, foot, slope, relabel)
     sys_.transition("heel_strike", model.name, guard, reset, step=True)
     sys_.terminal("hip_on_ground", model.name, Guard(height_above_slope(model, hip, slope), -1), status="fell")
     if start is not None:
         sys_.default_start[model.name] = list(start)
     sys_.fixed_point_guess = list(guess) if guess is not None else (list(start) if start is not None else None)
-    sys_.max_step_time = max_step_time
     return sys_

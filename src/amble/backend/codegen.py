@@ -14,10 +14,10 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from .equations import Equations, derive
-from .errors import ModelError
-from .hybrid import Explicit, HybridSystem, Impact, Lock, target_exprs
-from .model import Model, t
+from ..derivation.equations import Equations, derive
+from ..errors import ModelError
+from ..modelling.hybrid import Explicit, HybridSystem, Impact, Lock, target_exprs
+from ..modelling.model import Model, t
 
 
 class _Printer(C99CodePrinter):
@@ -259,7 +259,6 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
                 "terminal": tr.terminal,
                 "step": tr.step,
                 "shift": (tr.reset.shift_point if tr.reset is not None else None),
-                "mirror": getattr(tr.reset, "mirror", None),
             }
             for tr in order
         ],

@@ -13,45 +13,19 @@ Conventions: SI units, angles in radians. The world frame has ``x`` forward, ``y
 (3D only), ``z`` up; gravity points along ``-z`` unless :meth:`Model.gravity` says otherwise.
 2D models live in the x–z plane. A slope is a *rotated ground*, not a rotated gravity: positions
 and angles are written against the true vertical, and the walking surface is a plane through
-the stance foot descending along ``+x`` (see :mod:`amble.walker`). That keeps angles in the
+the stance foot descending along ``+x`` (see :mod:`amble.modelling.walker`). That keeps angles in the
 convention of the thesis and of Drake (from the vertical, positive in the walking direction).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import sympy as sp
 
-from .errors import ModelError
-
-#: The time symbol, for explicitly time-dependent forces Γ(q, q̇, t).
-t = sp.Symbol("t", real=True)
-
-
-def R(theta: sp.Expr) -> sp.Matrix:
-    """2D unit vector at angle ``theta`` from the vertical, clockwise positive (thesis Eq. 6).
-
-    Returns ``(sin θ, cos θ)`` as an ``(x, z)`` column: the direction from a foot to the hip
-    of a leg leaning forward by ``theta``.
-    """
-    return sp.Matrix([sp.sin(theta), sp.cos(theta)])
-
-
-def R3(theta: sp.Expr, phi: sp.Expr) -> sp.Matrix:
-    """3D unit vector of thesis Eq. 37: ``(sin Θ cos Φ, sin Φ, cos Θ cos Φ)`` in ``(x, y, z)``.
-
-    ``Θ`` tilts the vector forward (sagittal plane), ``Φ`` sideways (coronal plane, towards +y).
-    """
-    return sp.Matrix([sp.sin(theta) * sp.cos(phi), sp.sin(phi), sp.cos(theta) * sp.cos(phi)])
-
-
-def vector(*components: Any) -> sp.Matrix:
-    """A column vector from components (numbers or sympy expressions)."""
-    if len(components) == 1 and isinstance(components[0], Iterable):
-        components = tuple(components[0])
-    return sp.Matrix([sp.sympify(c) for c in components])
+from ..errors import ModelError
+from .geometry import t, vector
 
 
 class Model:
@@ -63,9 +37,12 @@ class Model:
         A short identifier (used in messages and cache keys).
     dims:
         2 for planar models (points are ``(x, z)``), 3 for spatial ones (``(x, y, z)``).
+    time_unit:
+        Unit of time (``"s"``; a scaled model may say e.g. ``"√(l/g)"``). Velocities are in
+        ``<coordinate unit>/<time unit>``.
     """
 
-    def __init__(self, name: str, dims: int = 2) -> None:
+    def __init__(self, name: str, dims: int = 2, time_unit: str = "s") -> None:
         if dims not in (2, 3):
             raise ModelError(f"model {name!r}: dims must be 2 or 3, got {dims!r}")
         self.name = name
@@ -73,7 +50,11 @@ class Model:
         self.q: list[sp.Symbol] = []
         self.qd: list[sp.Symbol] = []
         self.params: dict[sp.Symbol, float] = {}
-        self.param_docs: dict[str, str] = {}
+        self.time_unit = time_unit
+        #: unit of each coordinate and parameter by name (plots, tables and file headers read it)
+        self.units: dict[str, str] = {}
+        #: one-line description of a parameter by name
+        self.descriptions: dict[str, str] = {}
         self.points: dict[str, sp.Matrix] = {}
         self.masses: dict[str, sp.Expr] = {}
         self.links: list[tuple[str, str]] = []
@@ -86,11 +67,11 @@ class Model:
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
-        self.look: list[Any] = []
 
     # ------------------------------------------------------------------ symbols
-    def coordinates(self, names: str | Sequence[str]) -> tuple[sp.Symbol, ...]:
-        """Declare generalized coordinates; returns their symbols (velocities: :meth:`dot`)."""
+    def coordinates(self, names: str | Sequence[str], unit: str = "rad") -> tuple[sp.Symbol, ...]:
+        """Declare generalized coordinates (in ``unit``, default radians); returns their symbols
+        (velocities: :meth:`dot`)."""
         if isinstance(names, str):
             names = names.replace(",", " ").split()
         out = []
@@ -100,6 +81,7 @@ class Model:
             s = sp.Symbol(n, real=True)
             self.q.append(s)
             self.qd.append(sp.Symbol(f"{n}_dot", real=True))
+            self.units[n] = unit
             out.append(s)
         return tuple(out)
 
@@ -107,8 +89,8 @@ class Model:
         """Declare parameters with default values, in keyword order; returns their symbols."""
         return tuple(self.parameter(k, v) for k, v in defaults.items())
 
-    def parameter(self, name: str, default: float, doc: str = "") -> sp.Symbol:
-        """Declare one parameter with its default value and an optional description (with unit)."""
+    def parameter(self, name: str, default: float, doc: str = "", unit: str = "") -> sp.Symbol:
+        """Declare one parameter with its default value, an optional one-line description and unit."""
         if any(str(s) == name for s in self.q) or any(str(s) == name for s in self.params):
             raise ModelError(f"model {self.name!r}: name {name!r} declared twice")
         try:
@@ -120,8 +102,28 @@ class Model:
         s = sp.Symbol(name, real=True)
         self.params[s] = value
         if doc:
-            self.param_docs[name] = doc
+            self.descriptions[name] = doc
+        if unit:
+            self.units[name] = unit
         return s
+
+    def declare_units(self, **units: str) -> None:
+        """Units of declared coordinates or parameters by name, e.g. ``declare_units(mh="kg", a="m")``."""
+        known = {str(s) for s in [*self.q, *self.params]}
+        for name, unit in units.items():
+            if name not in known:
+                raise ModelError(f"model {self.name!r}: unit for unknown name {name!r}")
+            self.units[name] = str(unit)
+
+    def unit(self, name: str) -> str:
+        """Unit of a coordinate, velocity (``<coordinate>_dot``) or parameter by name (``""`` if
+        undeclared)."""
+        if name in self.units:
+            return self.units[name]
+        base = name[: -len("_dot")] if name.endswith("_dot") else None
+        if base is not None and base in self.units and base in {str(s) for s in self.q}:
+            return f"{self.units[base]}/{self.time_unit}"
+        return ""
 
     def dot(self, coordinate: sp.Symbol) -> sp.Symbol:
         """The velocity symbol of a coordinate (named ``<coordinate>_dot``)."""
@@ -312,11 +314,11 @@ class Model:
         for k in subs:
             if k not in self.q:
                 raise ModelError(f"model {self.name!r}: {k} is not a coordinate and cannot be eliminated")
-        out = Model(name, self.dims)
+        out = Model(name, self.dims, self.time_unit)
         keep = [i for i, qi in enumerate(self.q) if qi not in subs]
         out.q = [self.q[i] for i in keep]
         out.qd = [self.qd[i] for i in keep]
-        out.params, out.param_docs = dict(self.params), dict(self.param_docs)
+        out.params, out.units, out.descriptions = dict(self.params), dict(self.units), dict(self.descriptions)
         for qi, v in subs.items():
             bad = v.free_symbols - set(out.q) - set(self.params) - {t}
             if bad:
@@ -335,7 +337,6 @@ class Model:
         jac = full.jacobian(out.q)
         out._forces = [jac.T * f.subs(vsubs) for f in self._forces]
         out._g, out._g_dir = self._g, self._g_dir
-        out.look = list(self.look)
         return out
 
     # ------------------------------------------------------------------ helpers
@@ -395,11 +396,6 @@ class Model:
         bad = sorted(str(s) for s in self.generalized_force.free_symbols - allowed_kv)
         if bad:
             raise ModelError(f"model {self.name!r}: forces use unknown symbols {', '.join(bad)}")
-
-    def _repr_latex_(self) -> str:
-        from .equations import derive
-
-        return derive(self).latex(display=True)
 
     def __repr__(self) -> str:
         return (

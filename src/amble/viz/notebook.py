@@ -1,0 +1,52 @@
+"""Rich display in Jupyter: a trajectory as the interactive 3D viewer, a limit cycle as its
+phase portrait.
+
+The simulation and analysis layers know nothing of drawing, so their types carry no
+``_repr_html_``; instead this module registers display formatters with IPython (its documented
+way to show third-party types), when ``amble.viz`` is imported inside a running IPython kernel.
+"""
+
+from __future__ import annotations
+
+import html as _html
+import io
+import sys
+from typing import Any
+
+_TRAJECTORY = ("amble.simulation.trajectory", "Trajectory")
+_CYCLE = ("amble.analysis.poincare", "LimitCycle")
+
+
+def trajectory_html(traj: Any, height: int = 480) -> str:
+    """The 3D viewer of a trajectory as an ``<iframe>`` for a notebook cell."""
+    from .animate import scene_of
+    from .html import render_html
+
+    page = render_html(scene_of(traj, fps=30.0), title=f"amble — {traj.system.name}")
+    return (f'<iframe srcdoc="{_html.escape(page)}" style="width:100%;height:{height}px;border:0" '
+            'sandbox="allow-scripts"></iframe>')
+
+
+def cycle_png(cycle: Any) -> bytes:
+    """The phase portrait of a limit cycle as PNG bytes."""
+    import matplotlib.pyplot as plt
+
+    from .plot import plot_limit_cycle
+
+    fig = plot_limit_cycle(cycle)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def register() -> bool:
+    """Register the formatters with the running IPython shell; ``False`` outside IPython."""
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    if shell is None:
+        return False
+    formatters = shell.display_formatter.formatters
+    formatters["text/html"].for_type_by_name(*_TRAJECTORY, trajectory_html)
+    formatters["image/png"].for_type_by_name(*_CYCLE, cycle_png)
+    return True
