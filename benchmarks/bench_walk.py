@@ -54,11 +54,10 @@ def _amble_setup() -> tuple[Any, Any, Any]:
 
 def amble_walk(k: Any, p: np.ndarray, x0: np.ndarray, steps: int, tol: float) -> tuple[int, np.ndarray]:
     """Walk ``steps`` steps on amble's fast path; returns (status code, final post-impact state)."""
-    from amble.backend.kernels import CTX_X
-    from amble.simulation.simulate import Options, run
+    from amble.simulation.engine import Options, run
 
-    st, ctx, _ = run(k, p, 0, x0, steps=steps, opts=Options(rtol=tol, atol=tol))
-    return st, ctx[CTX_X:CTX_X + 4].copy()
+    r = run(k, p, 0, x0, steps=steps, opts=Options(rtol=tol, atol=tol))
+    return r.code, r.x
 
 
 def _interleaved(k: Any, p: np.ndarray, x0: np.ndarray, steps: int, tol: float, repeats: int) -> dict[str, Any]:

@@ -18,7 +18,8 @@ from .modelling.geometry import R3, R, t, vector
 from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
 from .modelling.model import Model
 from .modelling.walker import Walker, distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
-from .simulation.simulate import Options, simulate
+from .simulation.engine import Options
+from .simulation.simulate import simulate
 from .simulation.trajectory import Event, Trajectory
 from .version import __version__  # noqa: F401  (amble.__version__)
 from .viz import animate, plot_limit_cycle, plot_trajectory

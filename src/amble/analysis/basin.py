@@ -19,12 +19,13 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.kernels import CTX_X, build
+from ..backend.kernels import build
 from ..errors import StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.simulate import Options, parameter_vector, run
+from ..simulation.engine import Options, run
+from ..simulation.simulate import parameter_vector
 from .bifurcation import on_section
-from .runner import COMPLETED, chunks, execute, open_client, status_name, sweep_values
+from .runner import chunks, execute, open_client, sweep_values
 from .store import ResultStore, fmt_value
 
 #: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
@@ -99,14 +100,13 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
             else:
                 while done < steps:
                     m = min(check_every, steps - done)
-                    st, ctx, _ = run(k, p, mi, x, steps=m, opts=opts)
-                    if st != COMPLETED:
-                        done += int(ctx[3])
-                        name = status_name(k, st, ctx)
-                        code, reason = (1 if name == "fell" else 3), name
+                    r = run(k, p, mi, x, steps=m, opts=opts)
+                    if not r.completed:
+                        done += r.steps
+                        code, reason = (1 if r.status == "fell" else 3), r.status
                         break
                     done += m
-                    x = ctx[CTX_X:CTX_X + n].copy()
+                    x = r.x
                     dist = float(np.max(np.abs(x - xs)))
                     if dist < tol:
                         break

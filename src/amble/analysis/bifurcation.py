@@ -18,11 +18,12 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.kernels import CTX_X, build
+from ..backend.kernels import build
 from ..errors import AmbleError, StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.simulate import Options, parameter_vector, run
-from .runner import COMPLETED, check_params, chunks, execute, open_client, status_name, sweep_values
+from ..simulation.engine import Options, run
+from ..simulation.simulate import parameter_vector
+from .runner import check_params, chunks, execute, open_client, sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns, state_from_row
 
 
@@ -67,7 +68,6 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
     mode = k.meta["modes"][0]
     snames = k.meta["state_names"][mode]
     mi = k.mode_index(mode)
-    n = k.meta["nx"][mi]
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
     x = None if seed is None else np.asarray(seed, float)
     out = []
@@ -86,20 +86,20 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
                     x0 = np.asarray(default_guess(system, params), float)
                 except AmbleError:
                     x0 = np.asarray(system.fixed_point_guess or system.default_start[mode], float)
-        st, ctx, _ = run(k, p, mi, x0, steps=transient, opts=opts) if transient > 0 else (COMPLETED, None, None)
+        r = run(k, p, mi, x0, steps=transient, opts=opts) if transient > 0 else None
         kept, times, fail = [], [], ""
-        if st != COMPLETED:
-            fail = f"{status_name(k, st, ctx)} during the transient"
+        if r is not None and not r.completed:
+            fail = f"{r.status} during the transient"
         else:
-            y = x0 if ctx is None else ctx[CTX_X:CTX_X + n].copy()
+            y = x0 if r is None else r.x
             for _ in range(keep):
-                st, ctx, _ = run(k, p, mi, y, steps=1, opts=opts)
-                if st != COMPLETED or int(ctx[1]) != mi:
-                    fail = f"{status_name(k, st, ctx)} after {transient + len(kept)} steps"
+                r = run(k, p, mi, y, steps=1, opts=opts)
+                if not r.completed or r.mode != mi:
+                    fail = f"{r.status} after {transient + len(kept)} steps"
                     break
-                y = ctx[CTX_X:CTX_X + n].copy()
+                y = r.x
                 kept.append(float(y[coord]))
-                times.append(float(ctx[0]))
+                times.append(r.t)
         if fail:
             row.update(status="failed", reason=fail, iterates=json.dumps(kept), step_times=json.dumps(times),
                        period="")
@@ -210,15 +210,14 @@ def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *
     p = parameter_vector(k, params)
     mode = k.meta["modes"][0]
     mi = k.mode_index(mode)
-    n = k.meta["nx"][mi]
     x = np.asarray(x0 if x0 is not None else (system.fixed_point_guess or system.default_start[mode]), float)
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
     rows = [x]
     for _ in range(steps):
-        st, ctx, _ = run(k, p, mi, x, steps=1, opts=opts)
-        if st != COMPLETED:
+        r = run(k, p, mi, x, steps=1, opts=opts)
+        if not r.completed:
             break
-        x = ctx[CTX_X:CTX_X + n].copy()
+        x = r.x
         rows.append(x)
     return np.array(rows)
 

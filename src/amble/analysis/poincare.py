@@ -21,10 +21,11 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.kernels import CTX_X, Kernels, build
+from ..backend.kernels import Kernels, build
 from ..errors import ConvergenceError, SimulationError, StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.simulate import Options, initial_state, parameter_vector, run, simulate
+from ..simulation.engine import Options, run
+from ..simulation.simulate import initial_state, parameter_vector, simulate
 
 
 @dataclass
@@ -96,19 +97,20 @@ class ReturnMap:
         self.n = self.k.meta["nx"][self.mi]
 
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, float]:
-        st, ctx, _ = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts)
-        if st != 2:
-            raise SimulationError(f"return map: the run did not complete {self.period} step(s) (status code {st})")
-        if int(ctx[1]) != self.mi:
+        r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts)
+        if not r.completed:
+            raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
+        if r.mode != self.mi:
             raise SimulationError("return map: the walker did not come back to the section's mode")
-        return ctx[CTX_X : CTX_X + self.n].copy(), float(ctx[0])
+        return r.x, r.t
 
     def last_impact(self, x: np.ndarray) -> tuple[int, float, np.ndarray]:
         """(transition index, time, pre-event state) of the last footfall when mapping ``x``."""
-        st, ctx, rec = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts,
-                           record=True, sample_dt=1e9)
-        if st != 2:
-            raise SimulationError(f"return map: the run did not complete {self.period} step(s) (status code {st})")
+        r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, record=True,
+                sample_dt=1e9)
+        if not r.completed:
+            raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
+        rec = r.recorded
         steps = [i for i, tr in enumerate(rec["etr"]) if self.k.meta["transitions"][int(tr)]["step"]]
         i = steps[-1]
         src = self.k.meta["transitions"][int(rec["etr"][i])]["source"]

@@ -21,11 +21,6 @@ from ..errors import ParameterError, StateError
 from ..modelling.hybrid import HybridSystem
 from .store import ResultStore
 
-#: Status codes of :func:`amble.simulate.run` that the sweeps branch on.
-COMPLETED, TERMINAL = 2, 3
-_RUN_STATUS = {1: "end_time", 2: "completed", 3: "terminal", 4: "fell", 5: "zeno", 6: "integrator_failure",
-               7: "integrator_failure", 8: "max_events", 9: "singular_mass", 10: "reset_failed"}
-
 
 class _Serial:
     """In-process stand-in for a Dask client (``scheduler='synchronous'``): runs tasks on submit."""
@@ -135,13 +130,4 @@ def chunks(idx: Sequence[int], size: int) -> list[list[int]]:
     return [list(idx[i:i + size]) for i in range(0, len(idx), size)]
 
 
-def status_name(k: Any, st: int, ctx: np.ndarray) -> str:
-    """Readable outcome of a run: a terminal transition's own status (e.g. ``hip_on_ground``'s
-    ``fell``), else the name of the run status code."""
-    if st == TERMINAL:
-        return str(k.meta["transitions"][int(ctx[10])]["terminal"])
-    return _RUN_STATUS.get(st, "integrator_failure")
-
-
-__all__ = ["COMPLETED", "TERMINAL", "check_params", "chunks", "execute", "open_client", "status_name",
-           "sweep_values"]
+__all__ = ["check_params", "chunks", "execute", "open_client", "sweep_values"]

@@ -1,0 +1,71 @@
+"""The one table of the Python ↔ C interface of a compiled system.
+
+Everything both languages must agree on is listed here once: the run status codes, the fields of
+the resumable context array ``ctx``, of the real and integer option arrays ``opt`` and ``iopt``,
+and the integer width of counters. The C header the engine includes is generated from these
+tables (:func:`c_header`), and a loaded library reports its layout back, which is compared with
+:data:`LAYOUT` at load — a stale library is refused instead of misread.
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+#: Run status codes: (code, C name, outcome name). Outcome ``None``: not an end of the run (the
+#: loop returns to have its buffers grown); ``"terminal"`` is refined to the terminal
+#: transition's own status (e.g. ``fell``).
+STATUS: tuple[tuple[int, str, str | None], ...] = (
+    (0, "BUFFER_FULL", None),
+    (1, "END_TIME", "end_time"),
+    (2, "STEPS_DONE", "completed"),
+    (3, "TERMINAL", "terminal"),
+    (4, "STEP_TIMEOUT", "fell"),
+    (5, "ZENO", "zeno"),
+    (6, "STEP_TOO_SMALL", "integrator_failure"),
+    (7, "NONFINITE", "integrator_failure"),
+    (8, "MAX_EVENTS", "max_events"),
+    (9, "SINGULAR_MASS", "singular_mass"),
+    (10, "RESET_FAILED", "reset_failed"),
+)
+
+#: Fields of ``ctx`` (float64), the resumable state of a run, in index order; the state vector
+#: follows from index :data:`CTX_X` on (``nx_max`` entries).
+CTX_FIELDS: tuple[str, ...] = (
+    "T",            # current time (s)
+    "MODE",         # current mode index
+    "H",            # next step size (s; 0: choose)
+    "STEPS",        # step transitions so far
+    "EVENTS",       # transitions so far
+    "TLAST_STEP",   # time of the last step transition
+    "TPREV_EVENT",  # time of the last transition (Zeno detection)
+    "ZENO",         # consecutive transitions closer than zeno_dt
+    "GRID_K",       # index of the next output-grid sample
+    "GRID_T0",      # time of output-grid sample 0
+    "INFO",         # transition index of a terminal or failed reset
+    "FRESH",        # 1: the initial row is still to be recorded
+)
+CTX_X = 16
+
+#: Fields of ``opt`` (float64), in index order.
+OPT_FIELDS: tuple[str, ...] = ("TEND", "RTOL", "ATOL", "MAXSTEP", "MAXSTEPTIME", "SAMPLEDT", "ZENODT")
+
+#: Fields of ``iopt`` (int64), in index order.
+IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZENON", "NSUB")
+
+CTX = {name: i for i, name in enumerate(CTX_FIELDS)}
+OPT = {name: i for i, name in enumerate(OPT_FIELDS)}
+IOPT = {name: i for i, name in enumerate(IOPT_FIELDS)}
+CODE = {name: code for code, name, _ in STATUS}
+OUTCOME = {code: outcome for code, _, outcome in STATUS}
+
+assert len(CTX_FIELDS) <= CTX_X, "ctx fields overlap the state vector"
+
+
+def _layout_text() -> str:
+    parts = [f"ST_{n}={c}" for c, n, _ in STATUS] + [f"CX_{n}={i}" for n, i in CTX.items()] + [f"CX_X={CTX_X}"]
+    parts += [f"OP_{n}={i}" for n, i in OPT.items()] + [f"IO_{n}={i}" for n, i in IOPT.items()]
+    return ";".join(parts)
+
+
+#: A 63-bit fingerprint of the whole layout; the compiled library reports the one it was built with.
+LAYOUT = int(hashlib.sha256(_layout_text().encode()).hexdigest()[:15], 16)

@@ -1,0 +1,156 @@
+"""The one place that talks to the compiled hybrid loop: option and context arrays laid out by
+:mod:`amble.backend.abi`, output buffers that grow on demand, and the outcome of a run.
+
+:func:`run` is the lean core: one compiled call integrates, locates events and applies resets;
+analysis code (return maps, sweeps) uses it directly, :func:`amble.simulation.simulate.simulate`
+wraps it for users.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..backend.abi import CODE, CTX, CTX_X, IOPT_FIELDS, OPT_FIELDS, OUTCOME
+from ..backend.kernels import Kernels
+
+
+@dataclass(frozen=True)
+class Options:
+    """Integration and outcome settings.
+
+    rtol, atol: DOP853 tolerances (relative, absolute). max_step: largest step (s, 0 = none).
+    max_step_time: a walker that makes no footfall for this long has ``fell`` (s, 0 = never).
+    zeno_dt, zeno_events: this many consecutive events each closer than ``zeno_dt`` (s) to the
+    previous one end the run as ``zeno``. max_events: hard cap on events. nsub: uniform guard
+    samples per integration step, in addition to the extremum of the cubic through ``g`` and ``ġ``
+    at both step ends (which already finds a guard dipping through zero and back inside a step).
+    """
+
+    rtol: float = 1e-10
+    atol: float = 1e-10
+    max_step: float = 0.0
+    max_step_time: float = 0.0
+    zeno_dt: float = 1e-6
+    zeno_events: int = 5
+    max_events: int = 1_000_000
+    nsub: int = 1
+
+
+@dataclass(frozen=True)
+class Run:
+    """Where a run ended: ``code`` (an :data:`amble.backend.abi.STATUS` code), ``status`` (its
+    outcome name; a terminal transition's own status, e.g. ``fell``), time ``t`` (s), ``mode``
+    index, state ``x`` (that mode's length), ``steps`` and ``events`` counted, ``info`` (index of
+    the transition that ended it, or −1), the raw ``ctx`` and the ``recorded`` buffers."""
+
+    code: int
+    status: str
+    t: float
+    mode: int
+    x: np.ndarray
+    steps: int
+    events: int
+    info: int
+    ctx: np.ndarray
+    recorded: dict[str, Any]
+
+    @property
+    def completed(self) -> bool:
+        """All requested steps were taken."""
+        return self.code == CODE["STEPS_DONE"]
+
+
+def outcome(k: Kernels, code: int, info: int) -> str:
+    """Readable outcome of a status code: a terminal transition's own status, else its name."""
+    if code == CODE["TERMINAL"]:
+        return str(k.meta["transitions"][info]["terminal"])
+    return OUTCOME.get(code) or "integrator_failure"
+
+
+def run(
+    k: Kernels,
+    p: np.ndarray,
+    mode: int,
+    x0: np.ndarray,
+    *,
+    t0: float = 0.0,
+    t_end: float = math.inf,
+    steps: int = 0,
+    opts: Options = Options(),
+    sample_dt: float = 0.0,
+    record: bool = False,
+) -> Run:
+    """Run from ``x0`` in mode ``mode`` at ``t0`` until ``t_end`` (s), ``steps`` step transitions
+    (0: no limit) or another end; record samples (every ``sample_dt`` s, 0: every integration step)
+    and events when ``record``."""
+    nxm = k.nx_max
+    ctx = np.zeros(CTX_X + nxm)
+    ctx[CTX["T"]], ctx[CTX["MODE"]], ctx[CTX["TLAST_STEP"]], ctx[CTX["GRID_T0"]] = t0, mode, t0, t0
+    ctx[CTX["TPREV_EVENT"]], ctx[CTX["FRESH"]] = -math.inf, 1.0
+    ctx[CTX_X : CTX_X + x0.size] = x0
+    opt_values = {"TEND": t_end, "RTOL": opts.rtol, "ATOL": opts.atol, "MAXSTEP": opts.max_step,
+                  "MAXSTEPTIME": opts.max_step_time, "SAMPLEDT": sample_dt if record else 0.0, "ZENODT": opts.zeno_dt}
+    opt = np.array([opt_values[f] for f in OPT_FIELDS], dtype=float)
+    cap, ecap = (1024, 64) if record else (0, 0)
+    buf = _Buffers(cap, ecap, nxm)
+    while True:
+        iopt_values = {"MAXSTEPS": steps, "MAXEVENTS": opts.max_events, "OUTCAP": buf.cap, "EVCAP": buf.ecap,
+                       "ZENON": opts.zeno_events, "NSUB": opts.nsub}
+        iopt = np.array([iopt_values[f] for f in IOPT_FIELDS], dtype=np.int64)
+        code = buf.call(k, p, ctx, opt, iopt)
+        if code != CODE["BUFFER_FULL"]:
+            break
+        buf.grow()
+    mi = int(ctx[CTX["MODE"]])
+    info = int(ctx[CTX["INFO"]]) if code in (CODE["TERMINAL"], CODE["RESET_FAILED"]) else -1
+    return Run(code=code, status=outcome(k, code, info), t=float(ctx[CTX["T"]]), mode=mi,
+               x=ctx[CTX_X : CTX_X + k.meta["nx"][mi]].copy(), steps=int(ctx[CTX["STEPS"]]),
+               events=int(ctx[CTX["EVENTS"]]), info=info, ctx=ctx, recorded=buf.result())
+
+
+class _Buffers:
+    def __init__(self, cap: int, ecap: int, nxm: int) -> None:
+        self.cap, self.ecap, self.nxm = cap, ecap, nxm
+        self.t = np.zeros(max(cap, 1))
+        self.mode = np.zeros(max(cap, 1), dtype=np.int32)
+        self.x = np.zeros((max(cap, 1), nxm))
+        self.et = np.zeros(max(ecap, 1))
+        self.etr = np.zeros(max(ecap, 1), dtype=np.int32)
+        self.epre = np.zeros((max(ecap, 1), nxm))
+        self.epost = np.zeros((max(ecap, 1), nxm))
+        self.n = np.zeros(1, dtype=np.int64)
+        self.ne = np.zeros(1, dtype=np.int64)
+
+    def call(self, k: Kernels, p, ctx, opt, iopt) -> int:
+        arrays = (p, ctx, opt, iopt, self.t, self.mode, self.x, self.n, self.et, self.etr, self.epre, self.epost,
+                  self.ne)
+        return int(k.simulate_raw(*[a.ctypes.data for a in arrays]))
+
+    def grow(self) -> None:
+        if self.cap == 0 and self.ecap == 0:
+            raise RuntimeError("buffer full without recording")  # cannot happen: C only reports it when recording
+        n, ne = int(self.n[0]), int(self.ne[0])
+        self.cap *= 2
+        self.ecap *= 2 if ne >= self.ecap - 1 else 1
+        for name, size in (("t", self.cap), ("mode", self.cap), ("x", self.cap)):
+            old = getattr(self, name)
+            new = np.zeros((size,) + old.shape[1:], dtype=old.dtype)
+            new[:n] = old[:n]
+            setattr(self, name, new)
+        for name in ("et", "etr", "epre", "epost"):
+            old = getattr(self, name)
+            new = np.zeros((self.ecap,) + old.shape[1:], dtype=old.dtype)
+            new[:ne] = old[:ne]
+            setattr(self, name, new)
+
+    def result(self) -> dict[str, Any]:
+        n, ne = int(self.n[0]), int(self.ne[0])
+        return {"t": self.t[:n].copy(), "mode": self.mode[:n].copy(), "x": self.x[:n].copy(),
+                "et": self.et[:ne].copy(), "etr": self.etr[:ne].copy(), "epre": self.epre[:ne].copy(),
+                "epost": self.epost[:ne].copy()}
+
+
