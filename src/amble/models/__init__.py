@@ -1,9 +1,11 @@
-"""The model library: each module defines ``NAME`` and ``build() -> HybridSystem``, written with
-the public API only. Modules in this package are discovered automatically."""
+"""The model library: each module defines ``NAME``, ``POSITION`` (its place in the listing) and
+``build() -> HybridSystem``, written with the public API only. Modules in this package are
+discovered automatically."""
 
 from __future__ import annotations
 
 import importlib
+import math
 import pkgutil
 from functools import cache, lru_cache
 
@@ -13,16 +15,15 @@ from ..modelling.hybrid import HybridSystem
 
 @lru_cache(maxsize=1)
 def registry() -> dict[str, str]:
-    """Model name → module name, for every module of this package that defines ``NAME``."""
-    out: dict[str, str] = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+    """Model name → module name, for every module of this package that defines ``NAME``, in the
+    order the modules declare with ``POSITION`` (then by name)."""
+    found: list[tuple[float, str, str]] = []
+    for info in pkgutil.iter_modules(__path__):
         mod = importlib.import_module(f"{__name__}.{info.name}")
         name = getattr(mod, "NAME", None)
         if name:
-            out[name] = info.name
-    order = ["compass-gait", "kneed-biped", "humanoid-2d", "humanoid-3d", "simplest-walker", "rimless-wheel"]
-    rank = {n: i for i, n in enumerate(order)}
-    return dict(sorted(out.items(), key=lambda kv: (rank.get(kv[0], len(order)), kv[0])))
+            found.append((float(getattr(mod, "POSITION", math.inf)), name, info.name))
+    return {name: module for _, name, module in sorted(found)}
 
 
 def names() -> list[str]:

@@ -17,6 +17,7 @@ plastic impact (derived) and the swap of the legs. Parameters (Table 2): ``mh`` 
 from amble import Model, R, walker
 
 NAME = "compass-gait"
+POSITION = 10  # place in `amble models` (ascending)
 
 
 def build():

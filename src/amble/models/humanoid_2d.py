@@ -33,6 +33,7 @@ from amble import R, Walker
 from amble.models.kneed_biped import kneed_model, kneed_walker
 
 NAME = "humanoid-2d"
+POSITION = 30  # place in `amble models` (ascending)
 
 
 def build() -> Walker:

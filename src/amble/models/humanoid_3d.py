@@ -50,6 +50,7 @@ import sympy as sp
 from amble import R3, Model, Walker, distance_along_slope, walker
 
 NAME = "humanoid-3d"
+POSITION = 40  # place in `amble models` (ascending)
 
 
 def _rot_y(a):

@@ -45,6 +45,7 @@ signs (angles counter-clockwise) at best, and lies on no heel-strike section of 
 from amble import Guard, Model, R, Walker, heel_strike, height_above_slope, joint_lock
 
 NAME = "kneed-biped"
+POSITION = 20  # place in `amble models` (ascending)
 
 
 def kneed_model(name: str, extra: str = "") -> Model:

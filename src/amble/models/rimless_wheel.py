@@ -52,6 +52,7 @@ import math
 from amble import Guard, HybridSystem, Impact, Model, R, distance_along_slope, height_above_slope, walker
 
 NAME = "rimless-wheel"
+POSITION = 60  # place in `amble models` (ascending)
 
 ALPHA = math.pi / 8
 SLOPE = 0.08

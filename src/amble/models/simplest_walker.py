@@ -74,6 +74,7 @@ import sympy as sp
 from amble import Explicit, Guard, Model, R, Walker, height_above_slope
 
 NAME = "simplest-walker"
+POSITION = 50  # place in `amble models` (ascending)
 
 #: Post-heel-strike state of the stable gait at γ = 0.009 (Garcia et al. 1998), rounded to 7 digits.
 THETA_STAR = 0.2003109

@@ -1,0 +1,90 @@
+"""The layout contract: layers whose imports only go down, no import cycles, small modules.
+
+The layers and the forbidden imports are declared once, in ``[tool.importlinter]`` of
+``pyproject.toml``; import-linter checks them (including indirect chains between layers).
+Cycles between modules are found here from the same import graph.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import grimp
+import pytest
+from importlinter.cli import lint_imports
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src" / "amble"
+#: longest source file we accept (Python, C, JavaScript, CSS); vendored libraries aside
+MAX_LINES = 450
+
+
+def test_import_contracts_are_kept(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert lint_imports(config_filename=str(ROOT / "pyproject.toml"), no_cache=True, no_logo=True) == 0
+
+
+def _sccs(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+    counter = 0
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is None:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[v])
+                if low[v] == index[v]:
+                    comp = []
+                    while True:
+                        x = stack.pop()
+                        on.discard(x)
+                        comp.append(x)
+                        if x == v:
+                            break
+                    if len(comp) > 1:
+                        out.append(sorted(comp))
+            elif w not in index:
+                index[w] = low[w] = counter
+                counter += 1
+                stack.append(w)
+                on.add(w)
+                work.append((w, iter(sorted(graph[w]))))
+            elif w in on:
+                low[v] = min(low[v], index[w])
+    return out
+
+
+def test_no_import_cycles():
+    g = grimp.build_graph("amble")
+    packages = {m for m in g.modules if g.find_children(m)}
+    # a package's __init__ re-exports what lies below it; an import of the package by a module
+    # under it is not a dependency between ideas
+    graph = {m: {d for d in g.find_modules_directly_imported_by(m) if d not in packages}
+             for m in g.modules if m not in packages}
+    assert _sccs(graph) == []
+
+
+def test_cycle_finder_finds_a_cycle():
+    assert _sccs({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+@pytest.mark.parametrize("suffix", [".py", ".c", ".h", ".js", ".css", ".html"])
+def test_no_source_file_is_too_long(suffix):
+    long = {str(p.relative_to(SRC)): n for p in SRC.rglob(f"*{suffix}")
+            if "_vendor" not in p.parts and not p.name.endswith("_tableau.h")
+            for n in [len(p.read_text(errors="ignore").splitlines())] if n > MAX_LINES}
+    assert long == {}
