@@ -128,24 +128,24 @@ def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
                       final_mode=meta["modes"][r.mode])
 
 
+#: How each way of ending reads, by status name (:data:`amble.backend.abi.STATUS`).
+_MESSAGES = {
+    "TERMINAL": "{transition} at t = {t:.6g} s",
+    "STEPS_DONE": "{steps} steps in {t:.6g} s",
+    "END_TIME": "reached t = {t:.6g} s after {steps} steps",
+    "STEP_TIMEOUT": "no footfall within {max_step_time:g} s (t = {t:.6g} s)",
+    "ZENO": "{zeno_events} events less than {zeno_dt:g} s apart near t = {t:.9g} s",
+    "STEP_TOO_SMALL": "step size underflow at t = {t:.9g} s",
+    "NONFINITE": "state became non-finite near t = {t:.9g} s",
+    "SINGULAR_MASS": "mass matrix singular or ill-conditioned at t = {t:.9g} s, state {x}",
+    "RESET_FAILED": "reset of {transition!r} failed at t = {t:.9g} s",
+    "MAX_EVENTS": "{events} events, the most allowed, at t = {t:.6g} s",
+}
+
+
 def _message(r: Run, opts: Options, trs: list) -> str:
-    t, code = r.t, r.code
-    if code == CODE["TERMINAL"]:
-        return f"{trs[r.info]['name']} at t = {t:.6g} s"
-    if code == CODE["STEPS_DONE"]:
-        return f"{r.steps} steps in {t:.6g} s"
-    if code == CODE["END_TIME"]:
-        return f"reached t = {t:.6g} s after {r.steps} steps"
-    if code == CODE["STEP_TIMEOUT"]:
-        return f"no footfall within {opts.max_step_time:g} s (t = {t:.6g} s)"
-    if code == CODE["ZENO"]:
-        return f"{opts.zeno_events} events less than {opts.zeno_dt:g} s apart near t = {t:.9g} s"
-    if code == CODE["STEP_TOO_SMALL"]:
-        return f"step size underflow at t = {t:.9g} s"
-    if code == CODE["NONFINITE"]:
-        return f"state became non-finite near t = {t:.9g} s"
-    if code == CODE["SINGULAR_MASS"]:
-        return f"mass matrix singular or ill-conditioned at t = {t:.9g} s, state {r.x.tolist()}"
-    if code == CODE["RESET_FAILED"]:
-        return f"reset of {trs[r.info]['name']!r} failed at t = {t:.9g} s"
-    return f"stopped at t = {t:.6g} s"
+    name = next(n for n, c in CODE.items() if c == r.code)
+    template = _MESSAGES.get(name, "stopped at t = {t:.6g} s")
+    return template.format(t=r.t, steps=r.steps, events=r.events, x=r.x.tolist(), max_step_time=opts.max_step_time,
+                           zeno_events=opts.zeno_events, zeno_dt=opts.zeno_dt,
+                           transition=trs[r.info]["name"] if r.info >= 0 else "")
