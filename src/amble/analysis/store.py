@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import StateError
+from ..errors import OutputError
 
 
 class ResultStore:
@@ -49,7 +49,7 @@ class ResultStore:
         self.key = list(key)
         self.final: Path | None = Path(path) if path is not None else None
         if self.final is not None and self.final.suffix.lower() not in (".csv", ".parquet"):
-            raise StateError(f"result file {str(self.final)!r} must end with .csv or .parquet")
+            raise OutputError(f"result file {str(self.final)!r} must end with .csv or .parquet")
         self.parquet = self.final is not None and self.final.suffix.lower() == ".parquet"
         self.journal = (self.final.with_name(self.final.name + ".journal.csv") if self.parquet else self.final)
         self.rows: dict[tuple[str, ...], dict[str, str]] = {}
@@ -63,7 +63,7 @@ class ResultStore:
 
             tab = pq.read_table(self.final)
             if tab.column_names != self.columns:
-                raise StateError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
+                raise OutputError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
             for r in tab.to_pylist():
                 self._add({c: "" if r[c] is None else str(r[c]) for c in self.columns})
         if self.journal is None or not self.journal.exists() or self.journal.stat().st_size == 0:
@@ -78,7 +78,7 @@ class ResultStore:
         reader = csv.reader(lines)
         header = next(reader, None)
         if header != self.columns:
-            raise StateError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
+            raise OutputError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
                              "use another file")
         for fields in reader:
             if len(fields) == len(self.columns):
@@ -97,7 +97,7 @@ class ResultStore:
         extra = [k for k in self.rows if k not in w]
         if extra:
             shown = dict(zip(self.key, extra[0]))
-            raise StateError(f"{str(self.final)!r} holds {len(extra)} point(s) of another sweep (e.g. {shown}); "
+            raise OutputError(f"{str(self.final)!r} holds {len(extra)} point(s) of another sweep (e.g. {shown}); "
                              "use another file or the same grid")
 
     def has(self, key: tuple[str, ...]) -> bool:
