@@ -10,7 +10,9 @@ from .errors import (
     CompileError,
     ConvergenceError,
     ModelError,
+    OutputError,
     ParameterError,
+    SchedulerError,
     SimulationError,
     StateError,
 )
@@ -26,8 +28,8 @@ from .viz import animate, plot_limit_cycle, plot_trajectory
 
 __all__ = [
     "AmbleError", "CompileError", "ConvergenceError", "Equations", "Event", "Explicit", "Guard",
-    "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "ParameterError", "R", "R3",
-    "SimulationError", "StateError", "Trajectory", "Walker", "animate", "derive", "distance_along_slope",
-    "heel_strike", "height_above_slope", "joint_lock", "plot_limit_cycle", "plot_trajectory", "simulate", "t",
-    "vector", "walker",
+    "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError", "ParameterError", "R", "R3",
+    "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate", "derive",
+    "distance_along_slope", "heel_strike", "height_above_slope", "joint_lock", "plot_limit_cycle",
+    "plot_trajectory", "simulate", "t", "vector", "walker",
 ]

@@ -33,3 +33,12 @@ class SimulationError(AmbleError, RuntimeError):
 
 class ConvergenceError(AmbleError, RuntimeError):
     """An iterative method (e.g. the fixed-point search) did not converge."""
+
+
+class OutputError(AmbleError, OSError):
+    """An output path or result file cannot be used: wrong suffix, missing or unwritable directory,
+    unwritable file, or a result file that holds another sweep."""
+
+
+class SchedulerError(AmbleError, ConnectionError):
+    """The Dask scheduler or its workers cannot be reached or used."""

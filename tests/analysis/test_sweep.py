@@ -108,11 +108,11 @@ def test_interrupted_sweep_resumes_to_identical_file(compass, tmp_path, suffix):
 
 
 def test_file_of_another_grid_is_refused(compass, tmp_path):
-    from amble.errors import StateError
+    from amble.errors import OutputError
 
     out = tmp_path / "s.csv"
     sweep_fixed_points(compass, "slope", [0.04, 0.05], out=out, **SYNC)
-    with pytest.raises(StateError, match="another sweep"):
+    with pytest.raises(OutputError, match="another sweep"):
         sweep_fixed_points(compass, "slope", [0.04, 0.06], out=out, **SYNC)
 
 

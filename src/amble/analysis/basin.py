@@ -23,13 +23,16 @@ from ..backend.kernels import build
 from ..errors import StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
-from ..simulation.simulate import parameter_vector
 from .bifurcation import on_section
-from .runner import chunks, execute, open_client, sweep_values
-from .store import ResultStore, fmt_value
+from .defaults import BASIN_STEPS, BASIN_TOL
+from .runner import sweep_values
+from .sweep_runner import compiled, point_key, run_sweep
 
 #: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
 BASIN_LABELS = ("converged", "fell", "not converged", "failed")
+#: Columns of a basin result file and their types (:data:`amble.analysis.store.COLUMN_TYPES`).
+BASIN_COLUMNS = {"i": "int", "j": "int", "a": "float", "b": "float", "outcome": "str", "reason": "str", "steps": "int",
+                 "distance": "float"}
 
 
 @dataclass
@@ -126,7 +129,7 @@ def basin(
     params: Mapping[str, float] | None = None,
     base_state: Sequence[float] | None = None,
     to_state: Callable[[float, float, np.ndarray], np.ndarray] | None = None,
-    steps: int = 60,
+    steps: int = BASIN_STEPS,
     check_every: int = 5,
     tol: float = 1e-4,
     rows_per_task: int = 5,
@@ -135,8 +138,8 @@ def basin(
     workers: int | None = None,
     progress: bool = True,
     max_points: int | None = None,
-    rtol: float = 1e-8,
-    atol: float = 1e-8,
+    rtol: float = BASIN_TOL,
+    atol: float = BASIN_TOL,
 ) -> BasinResult:
     """Basin of attraction of the period-1 gait over two post-impact coordinates.
 
@@ -152,10 +155,7 @@ def basin(
     """
     from .poincare import find_fixed_point
 
-    k = build(system)
-    pvec = parameter_vector(k, params)
-    mode = k.meta["modes"][0]
-    snames = list(k.meta["state_names"][mode])
+    k, pvec, snames = compiled(system, params)
     for nm in x_names:
         if nm not in snames:
             raise StateError(f"unknown coordinate {nm!r}; known: {', '.join(snames)}")
@@ -172,44 +172,32 @@ def basin(
     if to_state is None:
         slope = float(pvec[k.meta["params"].index("slope")]) if "slope" in k.meta["params"] else None
         to_state = SetCoordinates(snames, x_names, slope)
-    cols = ["i", "j", "a", "b", "outcome", "reason", "steps", "distance"]
-    store = ResultStore(out, cols, ["i", "j", "a", "b"])
+    keys = [[point_key(i, j, float(a), float(b)) for j, b in enumerate(bv)] for i, a in enumerate(av)]
 
-    def key(i: int, j: int) -> tuple[str, ...]:
-        return (str(i), str(j), fmt_value(float(av[i])), fmt_value(float(bv[j])))
+    def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
+        return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
+                to_state, steps, check_every, tol, rtol, atol)
 
-    store.check_keys([key(i, j) for i in range(len(av)) for j in range(len(bv))])
-    pending = [i for i in range(len(av)) if not all(store.has(key(i, j)) for j in range(len(bv)))]
-    budget_rows = len(pending) if max_points is None else max(0, int(max_points)) // len(bv)
-    pending = pending[:budget_rows]
-    tasks = []
-    for grp in chunks(pending, rows_per_task):
-        tasks.append((system, pvec.tolist(), [(i, float(av[i])) for i in grp], bv.tolist(), base.tolist(),
-                      xs.tolist(), to_state, steps, check_every, tol, rtol, atol))
-    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
-    try:
-        execute(client, _basin_task, tasks, store, progress, len(pending) * len(bv), "basin")
-    finally:
-        close()
+    res = run_sweep(kind="basin", columns=BASIN_COLUMNS, key=["i", "j", "a", "b"], keys=keys,
+                    groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,
+                    scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
+                    params=list(x_names), state_names=snames)
+    stored = {(int(r["i"]), int(r["j"])): r for r in res.rows}
     outcome = np.full((len(av), len(bv)), -1, dtype=int)
     st = np.zeros((len(av), len(bv)), dtype=int)
     dist = np.full((len(av), len(bv)), math.nan)
     why = np.full((len(av), len(bv)), "", dtype=object)
-    complete = True
     for i in range(len(av)):
         for j in range(len(bv)):
-            r = store.rows.get(key(i, j))
+            r = stored.get((i, j))
             if r is None:
-                complete = False
                 continue
             outcome[i, j] = BASIN_LABELS.index(r["outcome"])
             st[i, j] = int(r["steps"])
             dist[i, j] = float(r["distance"]) if r["distance"] not in ("", "nan") else math.nan
             why[i, j] = r["reason"]
-    if complete:
-        store.compact()
     return BasinResult(names=tuple(x_names), a_values=av, b_values=bv, outcome=outcome, steps=st, distance=dist,
-                       fixed_point=xs, path=str(out) if out else None, computed=len(pending) * len(bv),
+                       fixed_point=xs, path=str(out) if out else None, computed=res.computed,
                        state_names=snames, reasons=why)
 
 

@@ -23,8 +23,10 @@ from ..errors import AmbleError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
 from ..simulation.simulate import parameter_vector
-from .runner import check_params, chunks, execute, open_client, sweep_values
-from .store import ResultStore, SweepResult, fmt_value, state_columns, state_from_row
+from .defaults import BIFURCATION_TOL
+from .runner import chunks, sweep_values
+from .store import ResultStore, SweepResult, state_columns
+from .sweep_runner import compiled, point_key, run_sweep, seed_before
 
 
 def on_section(state_names: Sequence[str], params: Mapping[str, float], x: np.ndarray) -> np.ndarray:
@@ -38,8 +40,9 @@ def on_section(state_names: Sequence[str], params: Mapping[str, float], x: np.nd
     return x
 
 
-def _bif_columns(param: str, snames: Sequence[str]) -> list[str]:
-    return ["i", param, "status", "reason", "coordinate", "iterates", "step_times", "period"] + state_columns(snames)
+def _bif_columns(param: str, snames: Sequence[str]) -> dict[str, str]:
+    return {"i": "int", param: "float", "status": "str", "reason": "str", "coordinate": "str", "iterates": "json",
+            "step_times": "json", "period": "int", **dict.fromkeys(state_columns(snames), "float")}
 
 
 def _period(vals: Sequence[float], tol: float) -> int:
@@ -128,8 +131,8 @@ def bifurcation(
     workers: int | None = None,
     progress: bool = True,
     max_points: int | None = None,
-    rtol: float = 1e-10,
-    atol: float = 1e-10,
+    rtol: float = BIFURCATION_TOL,
+    atol: float = BIFURCATION_TOL,
     period_tol: float = 1e-6,
 ) -> SweepResult:
     """Bifurcation diagram: post-transient return-map iterates of one coordinate along ``param``.
@@ -143,10 +146,7 @@ def bifurcation(
     A value where the walker falls is recorded ``failed`` with the reason.
     """
     v = sweep_values(values, param)
-    k = build(system)
-    parameter_vector(k, params)
-    check_params(system, [param])
-    snames = k.meta["state_names"][k.meta["modes"][0]]
+    _, _, snames = compiled(system, params, [param])
     if isinstance(coordinate, str):
         if coordinate not in snames:
             raise StateError(f"unknown coordinate {coordinate!r}; known: {', '.join(snames)}")
@@ -157,38 +157,17 @@ def bifurcation(
             raise StateError(f"coordinate index {coord} out of range 0..{len(snames) - 1}")
     if transient < 0 or keep < 1 or chunk < 1:
         raise StateError("need transient ≥ 0, keep ≥ 1 and chunk ≥ 1")
-    store = ResultStore(out, _bif_columns(param, snames), ["i", param])
-    keys = [(str(i), fmt_value(float(x))) for i, x in enumerate(v)]
-    store.check_keys(keys)
-    total = sum(1 for key in keys if not store.has(key))
-    budget = total if max_points is None else max(0, min(total, int(max_points)))
-    tasks, n_sched = [], 0
-    for grp in chunks(list(range(len(v))), chunk):
-        pts = [g for g in grp if not store.has(keys[g])]
-        if not pts or n_sched >= budget:
-            continue
-        pts = pts[: budget - n_sched]
-        first = grp.index(pts[0])
-        seed = None
-        if first > 0:  # previous value's last state, exactly as stored
-            r = store.rows.get(keys[grp[first - 1]])
-            x = None if r is None or r["status"] != "ok" else state_from_row(r, snames)
-            seed = None if x is None else x.tolist()
-        tasks.append((system, dict(params or {}), param, [(g, float(v[g])) for g in pts], seed, coord, transient,
-                      keep, rtol, atol, period_tol))
-        n_sched += len(pts)
-    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
-    try:
-        execute(client, _bif_task, tasks, store, progress, n_sched, "bifurcation")
-    finally:
-        close()
-    complete = all(store.has(key) for key in keys)
-    if complete:
-        store.compact()
-    wanted = set(keys)
-    rows = [r for r in store.sorted_rows() if (r["i"], r[param]) in wanted]
-    return SweepResult(kind="bifurcation", params=[param], rows=rows, path=str(out) if out else None,
-                       complete=complete, computed=n_sched, reused=len(keys) - total, state_names=list(snames))
+    keys = [[point_key(i, float(x))] for i, x in enumerate(v)]
+
+    def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:
+        seed = seed_before(store, keys, grp, pts[0], snames, back=1)  # previous value's last state, as stored
+        return (system, dict(params or {}), param, [(g, float(v[g])) for g in pts], seed, coord, transient, keep,
+                rtol, atol, period_tol)
+
+    return run_sweep(kind="bifurcation", columns=_bif_columns(param, snames), key=["i", param], keys=keys,
+                     groups=chunks(list(range(len(v))), chunk), make_task=make_task, fn=_bif_task, out=out,
+                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points, params=[param],
+                     state_names=snames)
 
 
 def first_period_doubling_iterates(result: SweepResult) -> float | None:
@@ -202,8 +181,8 @@ def first_period_doubling_iterates(result: SweepResult) -> float | None:
 
 
 def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *,
-                      params: Mapping[str, float] | None = None, steps: int = 200, rtol: float = 1e-10,
-                      atol: float = 1e-10) -> np.ndarray:
+                      params: Mapping[str, float] | None = None, steps: int = 200, rtol: float = BIFURCATION_TOL,
+                      atol: float = BIFURCATION_TOL) -> np.ndarray:
     """Successive post-impact states (steps+1 × n; row 0 = x0 or the model's guess); rows after
     a fall are absent (the array is shorter)."""
     k = build(system)

@@ -22,14 +22,16 @@ import numpy as np
 from ..backend.kernels import build
 from ..errors import AmbleError, StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.simulate import parameter_vector
-from .runner import check_params, chunks, execute, open_client, sweep_values
-from .store import ResultStore, SweepResult, fmt_value, state_columns, state_from_row
+from .defaults import FIXED_POINT_TOL
+from .runner import chunks, sweep_values
+from .store import ResultStore, SweepResult, state_columns
+from .sweep_runner import compiled, point_key, run_sweep, seed_before
 
 
-def _fp_columns(pnames: Sequence[str], snames: Sequence[str]) -> list[str]:
-    return (["i", "j"] + list(pnames) + ["status", "reason"] + state_columns(snames)
-            + ["step_time", "max_modulus", "moduli", "multipliers", "stable", "residual", "seeded"])
+def _fp_columns(pnames: Sequence[str], snames: Sequence[str]) -> dict[str, str]:
+    return {"i": "int", "j": "int", **dict.fromkeys(pnames, "float"), "status": "str", "reason": "str",
+            **dict.fromkeys(state_columns(snames), "float"), "step_time": "float", "max_modulus": "float",
+            "moduli": "json", "multipliers": "json", "stable": "bool", "residual": "float", "seeded": "bool"}
 
 
 def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], points: list[tuple[int, int, tuple]],
@@ -67,53 +69,19 @@ def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], po
 
 
 def _fp_sweep(system: HybridSystem, pnames: list[str], grid: list[tuple[int, int, tuple]],
-              groups: list[list[int]], *, params: Mapping[str, float] | None, continuation: bool, out: Any,
-              scheduler: Any, workers: int | None, progress: bool, max_points: int | None,
-              kind: str, fp_kw: dict[str, Any]) -> SweepResult:
-    k = build(system)  # compile once here, so workers only load from the disk cache
-    parameter_vector(k, params)
-    check_params(system, pnames)
-    snames = k.meta["state_names"][k.meta["modes"][0]]
-    cols = _fp_columns(pnames, snames)
-    store = ResultStore(out, cols, ["i", "j", *pnames])
-    keyof = [(str(i), str(j), *(fmt_value(float(x)) for x in vals)) for i, j, vals in grid]
-    store.check_keys(keyof)
-    total = sum(1 for key in keyof if not store.has(key))
-    budget = total if max_points is None else max(0, min(total, int(max_points)))
-    tasks, n_sched = [], 0
-    for grp in groups:
-        pts = [g for g in grp if not store.has(keyof[g])]
-        if not continuation:
-            pts_chunks = [[g] for g in pts]
-        else:
-            pts_chunks = [pts] if pts else []
-        for pc in pts_chunks:
-            if n_sched >= budget:
-                break
-            pc = pc[: budget - n_sched]
-            seed = None
-            if continuation:  # last converged point before this one in the chunk, as stored (exact)
-                first = grp.index(pc[0])
-                for g in reversed(grp[:first]):
-                    r = store.rows.get(keyof[g])
-                    if r is not None and r["status"] == "ok":
-                        x = state_from_row(r, snames)
-                        seed = None if x is None else x.tolist()
-                        break
-            tasks.append((system, dict(params or {}), pnames, [grid[g] for g in pc], seed, fp_kw))
-            n_sched += len(pc)
-    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
-    try:
-        execute(client, _fp_task, tasks, store, progress, n_sched, kind)
-    finally:
-        close()
-    complete = all(store.has(key) for key in keyof)
-    if complete:
-        store.compact()
-    wanted = set(keyof)
-    rows = [r for r in store.sorted_rows() if (r["i"], r["j"], *(r[p] for p in pnames)) in wanted]
-    return SweepResult(kind=kind, params=pnames, rows=rows, path=str(out) if out else None, complete=complete,
-                       computed=n_sched, reused=len(keyof) - total, state_names=list(snames))
+              groups: list[list[int]], *, params: Mapping[str, float] | None, continuation: bool, kind: str,
+              fp_kw: dict[str, Any], **run: Any) -> SweepResult:
+    _, _, snames = compiled(system, params, pnames)
+    keys = [[point_key(i, j, *vals)] for i, j, vals in grid]
+
+    def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:
+        # continuation: seeded by the last converged point before this one in the chunk, as stored (exact)
+        seed = seed_before(store, keys, grp, pts[0], snames) if continuation else None
+        return (system, dict(params or {}), pnames, [grid[g] for g in pts], seed, fp_kw)
+
+    return run_sweep(kind=kind, columns=_fp_columns(pnames, snames), key=["i", "j", *pnames], keys=keys,
+                     groups=groups, make_task=make_task, fn=_fp_task, split=None if continuation else 1,
+                     params=pnames, state_names=snames, **run)
 
 
 def sweep_fixed_points(
@@ -129,8 +97,8 @@ def sweep_fixed_points(
     workers: int | None = None,
     progress: bool = True,
     max_points: int | None = None,
-    rtol: float = 1e-12,
-    atol: float = 1e-12,
+    rtol: float = FIXED_POINT_TOL,
+    atol: float = FIXED_POINT_TOL,
     tol: float = 1e-10,
 ) -> SweepResult:
     """Fixed-point branch of the return map along ``param`` (1D continuation).
@@ -167,8 +135,8 @@ def sweep_fixed_points_2d(
     workers: int | None = None,
     progress: bool = True,
     max_points: int | None = None,
-    rtol: float = 1e-12,
-    atol: float = 1e-12,
+    rtol: float = FIXED_POINT_TOL,
+    atol: float = FIXED_POINT_TOL,
     tol: float = 1e-10,
 ) -> SweepResult:
     """Parameter map: fixed points on the grid ``values[0] × values[1]`` of two parameters.

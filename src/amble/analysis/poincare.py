@@ -26,6 +26,7 @@ from ..errors import ConvergenceError, SimulationError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
+from .defaults import FIXED_POINT_TOL
 
 
 @dataclass
@@ -190,8 +191,8 @@ def find_fixed_point(
     *,
     params: Mapping[str, float] | None = None,
     period: int = 1,
-    rtol: float = 1e-12,
-    atol: float = 1e-12,
+    rtol: float = FIXED_POINT_TOL,
+    atol: float = FIXED_POINT_TOL,
     tol: float = 1e-10,
     max_iter: int = 40,
 ) -> LimitCycle:

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..backend.kernels import build
-from ..errors import ParameterError, StateError
+from ..errors import ParameterError, SchedulerError, StateError
 from ..modelling.hybrid import HybridSystem
 from .store import ResultStore
 
@@ -58,10 +58,11 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
     if isinstance(scheduler, Client):
         return scheduler, lambda: None
     if scheduler:
+        _refuse_fast(str(scheduler))
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as e:
-            raise StateError(f"cannot connect to the Dask scheduler at {scheduler!r} ({e})") from None
+            raise SchedulerError(f"cannot connect to the Dask scheduler at {scheduler!r} ({e})") from None
         return client, client.close
     n = workers or os.cpu_count() or 1
     if n < 1:
@@ -74,6 +75,27 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
         cluster.close()
 
     return client, close
+
+
+def _refuse_fast(address: str) -> None:
+    """Raise :class:`SchedulerError` at once when nothing listens at a ``tcp://host:port`` address
+    (the Dask client would retry a refused connection until its timeout)."""
+    import socket
+    from urllib.parse import urlsplit
+
+    try:
+        u = urlsplit(address)
+        host, port = u.hostname, u.port
+    except ValueError:
+        return
+    if u.scheme != "tcp" or not host or not port:
+        return
+    try:
+        socket.create_connection((host, port), timeout=2).close()
+    except ConnectionRefusedError as e:
+        raise SchedulerError(f"cannot connect to the Dask scheduler at {address!r} ({e.strerror})") from None
+    except OSError:
+        pass  # unreachable or slow: let the client try, with its own timeout
 
 
 def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, progress: bool, total: int,

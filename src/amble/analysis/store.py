@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
@@ -33,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import StateError
+from ..errors import OutputError
 
 
 class ResultStore:
@@ -49,7 +50,7 @@ class ResultStore:
         self.key = list(key)
         self.final: Path | None = Path(path) if path is not None else None
         if self.final is not None and self.final.suffix.lower() not in (".csv", ".parquet"):
-            raise StateError(f"result file {str(self.final)!r} must end with .csv or .parquet")
+            raise OutputError(f"result file {str(self.final)!r} must end with .csv or .parquet")
         self.parquet = self.final is not None and self.final.suffix.lower() == ".parquet"
         self.journal = (self.final.with_name(self.final.name + ".journal.csv") if self.parquet else self.final)
         self.rows: dict[tuple[str, ...], dict[str, str]] = {}
@@ -63,7 +64,7 @@ class ResultStore:
 
             tab = pq.read_table(self.final)
             if tab.column_names != self.columns:
-                raise StateError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
+                raise OutputError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
             for r in tab.to_pylist():
                 self._add({c: "" if r[c] is None else str(r[c]) for c in self.columns})
         if self.journal is None or not self.journal.exists() or self.journal.stat().st_size == 0:
@@ -78,7 +79,7 @@ class ResultStore:
         reader = csv.reader(lines)
         header = next(reader, None)
         if header != self.columns:
-            raise StateError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
+            raise OutputError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
                              "use another file")
         for fields in reader:
             if len(fields) == len(self.columns):
@@ -97,7 +98,7 @@ class ResultStore:
         extra = [k for k in self.rows if k not in w]
         if extra:
             shown = dict(zip(self.key, extra[0]))
-            raise StateError(f"{str(self.final)!r} holds {len(extra)} point(s) of another sweep (e.g. {shown}); "
+            raise OutputError(f"{str(self.final)!r} holds {len(extra)} point(s) of another sweep (e.g. {shown}); "
                              "use another file or the same grid")
 
     def has(self, key: tuple[str, ...]) -> bool:
@@ -184,9 +185,34 @@ def state_from_row(row: Mapping[str, str], names: Sequence[str]) -> np.ndarray |
     return x if np.all(np.isfinite(x)) else None
 
 
+#: Column types of sweep rows: how :meth:`SweepResult.records` reads a stored text cell back
+#: (an empty cell is ``None``, or NaN for ``float``).
+COLUMN_TYPES = ("int", "float", "bool", "str", "json")
+
+
+def parse_value(text: str, kind: str) -> Any:
+    """A stored cell (:func:`fmt_value`) back as a value of the column type ``kind``."""
+    if kind == "str":
+        return text
+    if text == "":
+        return math.nan if kind == "float" else None
+    if kind == "float":
+        return float(text)
+    if kind == "int":
+        return int(text)
+    if kind == "bool":
+        return text == "true"
+    if kind == "json":
+        return json.loads(text)
+    raise ValueError(f"unknown column type {kind!r}; known: {', '.join(COLUMN_TYPES)}")
+
+
 @dataclass
 class SweepResult:
-    """Rows of a finished (or partial) sweep, sorted by key; values as written in the file (str)."""
+    """Rows of a finished (or partial) sweep, sorted by key; values as written in the file (str).
+
+    ``types``: column name → type (:data:`COLUMN_TYPES`); :meth:`records` and :meth:`table`
+    give the values as numbers."""
 
     kind: str
     params: list[str]
@@ -196,6 +222,23 @@ class SweepResult:
     computed: int
     reused: int
     state_names: list[str] = field(default_factory=list)
+    types: dict[str, str] = field(default_factory=dict)
+
+    def records(self) -> list[dict[str, Any]]:
+        """The rows with each value converted by its column type (untyped columns stay text)."""
+        return [{c: parse_value(v, self.types.get(c, "str")) for c, v in r.items()} for r in self.rows]
+
+    def table(self) -> dict[str, Any]:
+        """Column name → values: a NumPy array for ``int``/``float``/``bool`` columns without
+        empty cells (``float`` ones: NaN where empty), else a list."""
+        recs = self.records()
+        out: dict[str, Any] = {}
+        for c in (self.rows[0] if self.rows else self.types):
+            vals = [r[c] for r in recs]
+            kind = self.types.get(c, "str")
+            numeric = kind == "float" or (kind in ("int", "bool") and all(v is not None for v in vals))
+            out[c] = np.array(vals, dtype={"int": int, "float": float, "bool": bool}[kind]) if numeric else vals
+        return out
 
     def column(self, name: str) -> np.ndarray:
         """A numeric column (NaN where empty)."""
@@ -211,4 +254,4 @@ class SweepResult:
         return {"ok": ok, "failed": len(self.rows) - ok}
 
 
-__all__ = ["ResultStore", "SweepResult", "fmt_value", "state_columns", "state_from_row"]
+__all__ = ["COLUMN_TYPES", "ResultStore", "SweepResult", "fmt_value", "parse_value", "state_columns", "state_from_row"]

@@ -1,14 +1,16 @@
 """Command-line input: parsing of ``NAME=VALUE`` and ``NAME=START:STOP:COUNT`` options, output
-paths and model names, each refused with a :class:`UsageError` (exit code 2) before work starts."""
+paths and model names, each refused with a :class:`UsageError` (an output path: :class:`OutputError`;
+exit code 2) before work starts."""
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..errors import AmbleError
+from ..errors import AmbleError, OutputError
 
 
 class UsageError(AmbleError):
@@ -62,19 +64,25 @@ def parse_range(text: str) -> tuple[str, float, float, int]:
 
 
 def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path | None:
+    """``path`` as a :class:`Path` if it could be written, else :class:`OutputError`; creates nothing.
+
+    The suffix must be one of ``suffixes``; the directory must exist and be writable, and an
+    existing file must be a regular, writable file."""
     if path is None:
         return None
     p = Path(path)
     if p.suffix.lower() not in suffixes:
-        raise UsageError(f"{what}: {path!r} must end with one of {', '.join(suffixes)}")
+        raise OutputError(f"{what}: {path!r} must end with one of {', '.join(suffixes)}")
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
-        raise UsageError(f"{what}: directory {str(parent)!r} does not exist")
-    try:
-        with open(p, "a"):
-            pass
-    except OSError as e:
-        raise UsageError(f"{what}: cannot write {path!r} ({e.strerror})") from None
+        raise OutputError(f"{what}: directory {str(parent)!r} does not exist")
+    if p.exists():
+        if not p.is_file():
+            raise OutputError(f"{what}: {path!r} exists and is not a file")
+        if not os.access(p, os.W_OK):
+            raise OutputError(f"{what}: cannot write {path!r} (permission denied)")
+    elif not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{what}: cannot create {path!r} in {str(parent)!r} (permission denied)")
     return p
 
 

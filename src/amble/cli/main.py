@@ -12,6 +12,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
+from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 
@@ -208,11 +209,14 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--json", action="store_true", help="print a JSON object on stdout")
         return sp
 
-    def model_args(sp: argparse.ArgumentParser, tol: float) -> None:
+    def model_args(sp: argparse.ArgumentParser, tol: float | None) -> None:
+        """``tol=None``: the tolerances default to the API's default of the chosen kind."""
         sp.add_argument("model", help="model name (see 'amble models')")
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
-        sp.add_argument("--rtol", type=float, default=tol, help=f"relative tolerance (default {tol:g})")
-        sp.add_argument("--atol", type=float, default=tol, help=f"absolute tolerance (default {tol:g})")
+        said = (f"{tol:g}" if tol is not None else
+                "the kind's: " + ", ".join(f"{kind} {v:g}" for kind, v in SWEEP_TOL.items()))
+        sp.add_argument("--rtol", type=float, default=tol, help=f"relative tolerance (default {said})")
+        sp.add_argument("--atol", type=float, default=tol, help=f"absolute tolerance (default {said})")
 
     add("models", "list the model library").set_defaults(func=cmd_models)
     e = add("equations", "show the derived equations of motion and transitions of a model")
@@ -230,14 +234,14 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
-    model_args(lc, 1e-12)
+    model_args(lc, FIXED_POINT_TOL)
     lc.add_argument("--period", type=int, default=1, help="k for a period-k gait (default 1)")
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.set_defaults(func=cmd_limit_cycle)
     sw = add("sweep", "parameter sweep (fixed points, bifurcation diagram) or basin of attraction, on Dask")
-    model_args(sw, 1e-10)
+    model_args(sw, None)
     sw.add_argument("--kind", choices=("fixed-point", "bifurcation", "basin"), default="fixed-point",
                     help="continuation of the fixed point (default), post-transient iterates (bifurcation), "
                          "or which initial post-impact states walk into the gait (basin)")
@@ -249,7 +253,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "(e.g. --x stance=-0.4:0:100 --x stance_dot=0.5:1.6:100); the other coordinates "
                          "come from the fixed point (compass-like walkers: swing = 2*slope - stance)")
     sw.add_argument("--steps", type=int, default=None,
-                    help="--kind basin: footfalls walked from each initial state at most (default 60)")
+                    help=f"--kind basin: footfalls walked from each initial state at most (default {BASIN_STEPS})")
     sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")
     sw.add_argument("--plot", help="write a plot FILE.png|.svg|.pdf")
     sw.add_argument("--scheduler",

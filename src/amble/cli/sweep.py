@@ -17,6 +17,7 @@ import numpy as np
 
 from ..analysis.basin import BASIN_LABELS, BasinResult, basin
 from ..analysis.bifurcation import bifurcation, first_period_doubling_iterates
+from ..analysis.defaults import BASIN_STEPS
 from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from .args import UsageError, load_model, parse_range, parse_sets, writable_path
 
@@ -31,17 +32,13 @@ def sweep_cli(args: Any) -> dict[str, Any]:
     basin_kind = args.kind == "basin"
     ranges = _check_grid(args, basin_kind, UsageError)
     for nm in ("rtol", "atol"):
-        v = getattr(args, nm, 1e-10)
-        if not (v > 0 and math.isfinite(v)):
+        v = getattr(args, nm, None)
+        if v is not None and not (v > 0 and math.isfinite(v)):
             raise UsageError(f"--{nm} must be a positive number, got {v}")
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be at least 1, got {args.workers}")
     out = writable_path(args.out, (".csv", ".parquet"), "--out")
-    if out is not None and out.exists() and out.stat().st_size == 0:
-        out.unlink()  # _writable touched it; an empty file is no journal
     plot = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    if plot is not None and plot.stat().st_size == 0:
-        plot.unlink()
     system = load_model(args.model)
     names = [r[0] for r in ranges]
     if basin_kind:
@@ -53,8 +50,10 @@ def sweep_cli(args: Any) -> dict[str, Any]:
         for nm in names:
             if nm in sets:
                 raise UsageError(f"parameter {nm!r} is both swept and --set")
-    common = dict(params=sets, out=out, scheduler=args.scheduler, workers=args.workers,
-                  progress=not getattr(args, "json", False), rtol=args.rtol, atol=args.atol)
+    common: dict[str, Any] = dict(params=sets, out=out, scheduler=args.scheduler, workers=args.workers,
+                                  progress=not getattr(args, "json", False))
+    # a tolerance not given is the kind's own default (amble.analysis.defaults), read by the API
+    common.update({nm: getattr(args, nm) for nm in ("rtol", "atol") if getattr(args, nm, None) is not None})
     summary: dict[str, Any] = {"model": args.model, "kind": args.kind,
                                ("coordinates" if basin_kind else "parameters"): names,
                                "ranges": [list(r[1:]) for r in ranges], "set": sets, "file": str(out) if out else None}
@@ -123,8 +122,6 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
         res = bifurcation(system, names[0], vals[0], **common)
         summary["first_period_two"] = first_period_doubling_iterates(res)
     elif len(names) == 1:
-        # fixed points and their multipliers need tight tolerances, whatever the default
-        common["rtol"], common["atol"] = min(args.rtol, 1e-12), min(args.atol, 1e-12)
         res = sweep_fixed_points(system, names[0], vals[0], **common)
         summary["period_doubling"] = period_doubling(res)
         st = [r for r in res.rows if r["status"] == "ok" and r["stable"] == "true"]
@@ -142,7 +139,7 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
 def _run_basin(system: Any, ranges: list[tuple[str, float, float, int]], args: Any, common: dict[str, Any],
                summary: dict[str, Any]) -> BasinResult:
     """Basin of attraction over the two ``--x`` coordinates; fills ``summary``, returns the result."""
-    steps = 60 if args.steps is None else args.steps
+    steps = BASIN_STEPS if args.steps is None else args.steps
     res = basin(system, (ranges[0][0], ranges[1][0]), ((ranges[0][1], ranges[0][2]), (ranges[1][1], ranges[1][2])),
                 (ranges[0][3], ranges[1][3]), steps=steps, **common)
     counts = res.counts()

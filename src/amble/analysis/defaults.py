@@ -1,0 +1,25 @@
+"""Default settings of the analyses, defined once and read by the API and the command line.
+
+Integrator tolerances (relative and absolute alike):
+
+- :data:`FIXED_POINT_TOL` — fixed-point searches and fixed-point sweeps (branches and maps): the
+  multipliers come from finite differences of the return map and need tight integration;
+- :data:`BIFURCATION_TOL` — bifurcation diagrams and Poincaré iterates;
+- :data:`BASIN_TOL` — basins of attraction (only the outcome category of a cell matters).
+"""
+
+from __future__ import annotations
+
+#: rtol = atol of fixed-point searches and fixed-point sweeps.
+FIXED_POINT_TOL = 1e-12
+#: rtol = atol of bifurcation diagrams and Poincaré iterates.
+BIFURCATION_TOL = 1e-10
+#: rtol = atol of basins of attraction.
+BASIN_TOL = 1e-8
+#: Footfalls walked from each initial state of a basin, at most.
+BASIN_STEPS = 60
+
+#: The tolerance of each sweep kind, by its command-line name.
+SWEEP_TOL = {"fixed-point": FIXED_POINT_TOL, "bifurcation": BIFURCATION_TOL, "basin": BASIN_TOL}
+
+__all__ = ["BASIN_STEPS", "BASIN_TOL", "BIFURCATION_TOL", "FIXED_POINT_TOL", "SWEEP_TOL"]

@@ -1,0 +1,107 @@
+"""The one pipeline of every sweep kind: store → keys → budget → chunks → execute → compact → filter.
+
+A sweep is a list of *points*, each identified by one or more keys (a fixed-point or
+bifurcation point has one, a basin grid row one per cell), cut into *groups* (chunks whose
+boundaries depend only on the grid). The pending points of a group, up to the ``max_points``
+budget, become one task (or several of at most ``split`` points); a kind supplies only how to
+build a task from those points (with the continuation seed read back exactly from the store,
+:func:`seed_before`), the task function, and its columns. Only the client process writes the
+result file; when every key is present the file is compacted (sorted by key, atomically).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..backend.kernels import build
+from ..modelling.hybrid import HybridSystem
+from ..simulation.simulate import parameter_vector
+from .runner import check_params, execute, open_client
+from .store import ResultStore, SweepResult, fmt_value, state_from_row
+
+Key = tuple[str, ...]
+
+
+def compiled(system: HybridSystem, params: Mapping[str, float] | None,
+             swept: Sequence[str] = ()) -> tuple[Any, np.ndarray, list[str]]:
+    """The compiled kernels (built once here, so workers only load them from the disk cache), the
+    parameter vector of ``params`` and the state names of the first mode; ``swept`` must be
+    parameters of ``system``."""
+    k = build(system)
+    pvec = parameter_vector(k, params)
+    check_params(system, swept)
+    return k, pvec, list(k.meta["state_names"][k.meta["modes"][0]])
+
+
+def point_key(*fields: int | float) -> Key:
+    """A key: integers (grid indices) as decimal text, floats by ``repr`` (exact)."""
+    return tuple(str(f) if isinstance(f, int) else fmt_value(float(f)) for f in fields)
+
+
+def seed_before(store: ResultStore, keys: Sequence[Sequence[Key]], group: Sequence[int], first: int,
+                state_names: Sequence[str], back: int | None = None) -> list[float] | None:
+    """Continuation seed of a task starting at point ``first`` of ``group``: the stored state of
+    the last ``ok`` point before it (looking back at most ``back`` points), read back exactly."""
+    before = list(group[:group.index(first)])
+    if back is not None:
+        before = before[len(before) - back:] if back else []
+    for g in reversed(before):
+        r = store.rows.get(keys[g][0])
+        if r is not None and r["status"] == "ok":
+            x = state_from_row(r, state_names)
+            return None if x is None else x.tolist()
+    return None
+
+
+def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys: Sequence[Sequence[Key]],
+              groups: Sequence[Sequence[int]], make_task: Callable[[list[int], Sequence[int], ResultStore], tuple],
+              fn: Callable[..., list[dict[str, Any]]], out: str | os.PathLike | None, scheduler: Any,
+              workers: int | None, progress: bool, max_points: int | None, split: int | None = None,
+              params: Sequence[str] = (), state_names: Sequence[str] = ()) -> SweepResult:
+    """Run the pending points of a sweep and return every stored row of its grid, sorted by key.
+
+    ``columns``: column name → type (:data:`amble.analysis.store.COLUMN_TYPES`), in file order;
+    ``key``: the key columns; ``keys[g]``: the keys of point ``g`` (it is pending while one is
+    missing); ``groups``: the chunks of point indices. The pending points of a group, cut to the
+    budget (``max_points`` keys) and into runs of ``split`` points (default: all), become the
+    task ``make_task(points, group, store)``, run as ``fn(*task)``. ``computed`` / ``reused``
+    of the result count keys.
+    """
+    store = ResultStore(out, list(columns), key)
+    flat = [kk for ks in keys for kk in ks]
+    store.check_keys(flat)
+    per = max(1, max((len(ks) for ks in keys), default=1))  # keys per point (a basin row: its cells)
+    missing = sum(1 for kk in flat if not store.has(kk))
+    pending_points = sum(1 for ks in keys if not all(store.has(kk) for kk in ks))
+    budget = pending_points if max_points is None else max(0, min(pending_points, int(max_points) // per))
+    tasks, n_sched = [], 0
+    for grp in groups:
+        pts = [g for g in grp if not all(store.has(kk) for kk in keys[g])]
+        step = split or max(1, len(pts))
+        for run in (pts[i:i + step] for i in range(0, len(pts), step)):
+            if n_sched >= budget:
+                break
+            run = run[: budget - n_sched]
+            tasks.append(make_task(run, grp, store))
+            n_sched += len(run)
+    computed = n_sched * per
+    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
+    try:
+        execute(client, fn, tasks, store, progress, computed, kind)
+    finally:
+        close()
+    complete = all(store.has(kk) for kk in flat)
+    if complete:
+        store.compact()
+    wanted = set(flat)
+    rows = [r for r in store.sorted_rows() if tuple(r[c] for c in key) in wanted]
+    return SweepResult(kind=kind, params=list(params), rows=rows, path=str(out) if out else None, complete=complete,
+                       computed=computed, reused=len(flat) - missing, state_names=list(state_names),
+                       types=dict(columns))
+
+
+__all__ = ["compiled", "point_key", "run_sweep", "seed_before"]

@@ -1,0 +1,140 @@
+"""The sweep command line: tolerances reach the API as given (one default per setting, no silent
+override), option checks create no file, typed output / scheduler errors exit 2 with one line;
+typed rows of a sweep result."""
+
+from __future__ import annotations
+
+import inspect
+import json
+import math
+import time
+
+import pytest
+
+import amble.cli.sweep as cli_sweep
+from amble import OutputError, SchedulerError
+from amble.analysis.basin import basin
+from amble.analysis.bifurcation import bifurcation
+from amble.analysis.defaults import BASIN_STEPS, BASIN_TOL, BIFURCATION_TOL, FIXED_POINT_TOL
+from amble.analysis.fixed_points import sweep_fixed_points, sweep_fixed_points_2d
+from amble.analysis.poincare import find_fixed_point
+from amble.analysis.store import SweepResult
+from amble.cli.args import writable_path
+from amble.cli.main import main
+
+SYNC = {"scheduler": "synchronous", "progress": False}
+
+
+class _Stop(Exception):
+    pass
+
+
+def _capture(monkeypatch, name):
+    """Replace the API function ``name`` used by the CLI by one recording its keyword arguments."""
+    seen: dict = {}
+
+    def fake(*args, **kw):
+        seen.update(kw)
+        if name == "basin":
+            raise _Stop
+        return SweepResult(kind="fake", params=["slope"], rows=[], path=None, complete=True, computed=0, reused=0)
+
+    monkeypatch.setattr(cli_sweep, name, fake)
+    return seen
+
+
+def _default(fn, name):
+    return inspect.signature(fn).parameters[name].default
+
+
+def test_api_defaults_come_from_one_place():
+    for fn in (sweep_fixed_points, sweep_fixed_points_2d, find_fixed_point):
+        assert _default(fn, "rtol") == _default(fn, "atol") == FIXED_POINT_TOL
+    assert _default(bifurcation, "rtol") == _default(bifurcation, "atol") == BIFURCATION_TOL
+    assert _default(basin, "rtol") == _default(basin, "atol") == BASIN_TOL
+    assert _default(basin, "steps") == BASIN_STEPS
+
+
+@pytest.mark.parametrize("kind, grid, fn", [
+    ("fixed-point", ["--param", "slope=0.04:0.05:2"], "sweep_fixed_points"),
+    ("fixed-point", ["--param", "slope=0.04:0.05:2", "--param", "mh=9:10:2"], "sweep_fixed_points_2d"),
+    ("bifurcation", ["--param", "slope=0.04:0.05:2"], "bifurcation"),
+    ("basin", ["--x", "stance=-0.3:-0.2:2", "--x", "stance_dot=1:1.2:2"], "basin"),
+])
+def test_given_tolerance_is_used_and_absent_one_is_the_api_default(monkeypatch, kind, grid, fn):
+    seen = _capture(monkeypatch, fn)
+    argv = ["sweep", "compass-gait", "--kind", kind, *grid, "--scheduler", "synchronous", "--json"]
+    assert main([*argv, "--rtol", "1e-9", "--atol", "1e-7"]) in (0, 1)
+    assert seen["rtol"] == 1e-9 and seen["atol"] == 1e-7
+    seen.clear()
+    assert main(argv) in (0, 1)
+    assert "rtol" not in seen and "atol" not in seen  # → the API's default of that kind
+    if kind == "basin":
+        assert seen["steps"] == BASIN_STEPS
+
+
+def test_writable_path_creates_nothing(tmp_path):
+    p = tmp_path / "r.csv"
+    assert writable_path(str(p), (".csv",), "--out") == p
+    assert not p.exists()
+    with pytest.raises(OutputError, match="does not exist"):
+        writable_path(str(tmp_path / "no" / "r.csv"), (".csv",), "--out")
+    with pytest.raises(OutputError, match="must end with"):
+        writable_path(str(tmp_path / "r.txt"), (".csv",), "--out")
+    (tmp_path / "d.csv").mkdir()
+    with pytest.raises(OutputError, match="not a file"):
+        writable_path(str(tmp_path / "d.csv"), (".csv",), "--out")
+
+
+def test_refused_sweep_leaves_no_files(tmp_path):
+    out, plot = tmp_path / "s.csv", tmp_path / "s.png"
+    rc = main(["sweep", "compass-gait", "--param", "nope=0:1:2", "--scheduler", "synchronous", "--out", str(out),
+               "--plot", str(plot)])
+    assert rc == 2
+    assert not out.exists() and not plot.exists()
+
+
+def _one_line_error(capsys, argv, expected):
+    code = main([*argv, "--json"])
+    cap = capsys.readouterr()
+    assert code == 2
+    assert len(cap.err.strip().splitlines()) == 1 and cap.err.startswith("amble: error: ")
+    assert json.loads(cap.out)["type"] == expected
+
+
+def test_result_file_of_another_kind_exits_2_with_one_line(capsys, tmp_path):
+    out = tmp_path / "s.csv"
+    out.write_text("some,other,columns\n1,2,3\n")
+    _one_line_error(capsys, ["sweep", "compass-gait", "--param", "slope=0.04:0.05:2", "--scheduler", "synchronous",
+                             "--out", str(out)], "OutputError")
+    assert out.read_text() == "some,other,columns\n1,2,3\n"
+
+
+def test_unusable_out_path_exits_2_with_one_line(capsys, tmp_path):
+    _one_line_error(capsys, ["sweep", "compass-gait", "--param", "slope=0.04:0.05:2", "--scheduler", "synchronous",
+                             "--out", str(tmp_path / "missing" / "s.csv")], "OutputError")
+
+
+def test_refused_scheduler_exits_2_at_once(capsys):
+    t0 = time.perf_counter()
+    _one_line_error(capsys, ["sweep", "compass-gait", "--param", "slope=0.04:0.05:2", "--scheduler",
+                             "tcp://127.0.0.1:1"], "SchedulerError")
+    assert time.perf_counter() - t0 < 5.0
+    assert issubclass(SchedulerError, ConnectionError) and issubclass(OutputError, OSError)
+
+
+def test_records_and_table_give_numbers(compass):
+    res = sweep_fixed_points(compass, "slope", [0.04, 0.05], **SYNC)
+    assert all(isinstance(v, str) for v in res.rows[0].values())  # the stored text is unchanged
+    rec = res.records()[0]
+    assert isinstance(rec["i"], int) and isinstance(rec["slope"], float) and rec["slope"] == 0.04
+    assert isinstance(rec["stable"], bool) and isinstance(rec["step_time"], float)
+    assert isinstance(rec["multipliers"], list) and rec["reason"] == ""
+    tab = res.table()
+    assert tab["i"].tolist() == [0, 1] and tab["slope"].dtype == float and tab["stable"].dtype == bool
+    bif = bifurcation(compass, "slope", [0.05], transient=20, keep=4, **SYNC).records()[0]
+    assert isinstance(bif["period"], int) and len(bif["iterates"]) == 4
+    failed = SweepResult(kind="x", params=[], rows=[{"period": "", "d": ""}], path=None, complete=True, computed=0,
+                         reused=0, types={"period": "int", "d": "float"})
+    assert failed.records()[0]["period"] is None and math.isnan(failed.records()[0]["d"])
+    assert failed.table()["period"] == [None]
