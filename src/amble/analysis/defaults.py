@@ -12,6 +12,8 @@ from __future__ import annotations
 
 #: rtol = atol of fixed-point searches and fixed-point sweeps.
 FIXED_POINT_TOL = 1e-12
+#: Largest residual ``|P(x) − x|∞`` of a fixed point that a search returns.
+RESIDUAL_TOL = 1e-10
 #: rtol = atol of bifurcation diagrams and Poincaré iterates.
 BIFURCATION_TOL = 1e-10
 #: rtol = atol of basins of attraction.
@@ -22,4 +24,4 @@ BASIN_STEPS = 60
 #: The tolerance of each sweep kind, by its command-line name.
 SWEEP_TOL = {"fixed-point": FIXED_POINT_TOL, "bifurcation": BIFURCATION_TOL, "basin": BASIN_TOL}
 
-__all__ = ["BASIN_STEPS", "BASIN_TOL", "BIFURCATION_TOL", "FIXED_POINT_TOL", "SWEEP_TOL"]
+__all__ = ["BASIN_STEPS", "BASIN_TOL", "BIFURCATION_TOL", "FIXED_POINT_TOL", "RESIDUAL_TOL", "SWEEP_TOL"]

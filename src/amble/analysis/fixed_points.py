@@ -22,7 +22,7 @@ import numpy as np
 from ..backend.kernels import build
 from ..errors import AmbleError, StateError
 from ..modelling.hybrid import HybridSystem
-from .defaults import FIXED_POINT_TOL
+from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .runner import chunks, sweep_values
 from .store import ResultStore, SweepResult, state_columns
 from .sweep_runner import compiled, point_key, run_sweep, seed_before
@@ -99,7 +99,7 @@ def sweep_fixed_points(
     max_points: int | None = None,
     rtol: float = FIXED_POINT_TOL,
     atol: float = FIXED_POINT_TOL,
-    tol: float = 1e-10,
+    tol: float = RESIDUAL_TOL,
 ) -> SweepResult:
     """Fixed-point branch of the return map along ``param`` (1D continuation).
 
@@ -137,7 +137,7 @@ def sweep_fixed_points_2d(
     max_points: int | None = None,
     rtol: float = FIXED_POINT_TOL,
     atol: float = FIXED_POINT_TOL,
-    tol: float = 1e-10,
+    tol: float = RESIDUAL_TOL,
 ) -> SweepResult:
     """Parameter map: fixed points on the grid ``values[0] × values[1]`` of two parameters.
 

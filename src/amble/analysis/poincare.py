@@ -26,7 +26,7 @@ from ..errors import ConvergenceError, SimulationError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
-from .defaults import FIXED_POINT_TOL
+from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 
 
 @dataclass
@@ -84,7 +84,7 @@ class ReturnMap:
     """
 
     def __init__(self, system: HybridSystem, params: Mapping[str, float] | None = None, *, period: int = 1,
-                 rtol: float = 1e-12, atol: float = 1e-12, mode: str | None = None) -> None:
+                 rtol: float = FIXED_POINT_TOL, atol: float = FIXED_POINT_TOL, mode: str | None = None) -> None:
         if period < 1:
             raise StateError(f"period must be at least 1, got {period}")
         self.system = system
@@ -193,7 +193,7 @@ def find_fixed_point(
     period: int = 1,
     rtol: float = FIXED_POINT_TOL,
     atol: float = FIXED_POINT_TOL,
-    tol: float = 1e-10,
+    tol: float = RESIDUAL_TOL,
     max_iter: int = 40,
 ) -> LimitCycle:
     """Fixed point of the ``period``-step return map, its step time and Floquet multipliers.
