@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .errors import SceneError
-from .shapes import DIGITS, Box, Cylinder, Ground, Shape, Sphere, check_name, rounded
+from .shapes import DIGITS, Box, Ground, Shape, check_name, rounded
 
 __all__ = ["FORMAT", "frames"]
 
@@ -59,7 +59,7 @@ def frames(
     if len(grounds) > 1:
         raise SceneError(f"frames: at most one Ground, got {len(grounds)}")
     for s in shapes:
-        if not isinstance(s, (Sphere, Cylinder, Box, Ground)):
+        if not isinstance(s, Shape):
             raise SceneError(f"frames: not a shape: {s!r}")
 
     needed: list[str] = []
