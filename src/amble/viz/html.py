@@ -18,6 +18,12 @@ The page can be driven from a script:
   ``view`` (``iso``, ``side`` or ``front``: the initial camera direction).
 
 Keyboard: space plays/pauses, left/right arrows step one frame.
+
+The page's parts are package data in ``viewer/``: ``viewer.html`` (the template, with
+``@TITLE@``, ``@CSS@``, ``@SCENE@``, ``@THREE@`` and ``@VIEWER@`` placeholders),
+``viewer.css``, and the script in three parts of one function body: ``data.js`` (status,
+scene data, URL hash, frame lookup), ``scene.js`` (three.js objects and camera) and
+``player.js`` (time, controls, ``window.amble``, the loop).
 """
 
 from __future__ import annotations
