@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from amble.errors import AmbleError
+from amble.viz.errors import SceneError
 from amble.viz.html import render_html, write_html
 from amble.viz.scene import Cylinder, Ground, Sphere, frames
 
@@ -103,8 +105,20 @@ def test_scene_text_cannot_break_out_of_script() -> None:
 
 
 def test_rejects_non_scene(tmp_path: Path) -> None:
-    with pytest.raises(ValueError, match="amble.scene/1"):
+    with pytest.raises(SceneError, match="amble.scene/1"):
         write_html(tmp_path / "x.html", {"times": []})
+    with pytest.raises(AmbleError, match="'shapes'"):
+        render_html({"format": "amble.scene/1", "times": [0], "points": {}})
+
+
+def test_viewer_parts_are_filled_in() -> None:
+    scene = walker_scene(duration=0.1)
+    page = render_html(scene)
+    assert not re.search(r"@(TITLE|CSS|SCENE|THREE|VIEWER)@", page)  # every placeholder filled
+    # Inserted text is not searched for placeholders again.
+    assert render_html(scene, title="@CSS@").count("@CSS@") == 2  # in <title> and in the corner
+    for part in ("ambleState = 'ready'", "function addGround", "function locate", "#bar button"):
+        assert part in page
 
 
 # ---- in the browser ---------------------------------------------------------------

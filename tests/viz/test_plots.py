@@ -46,3 +46,19 @@ def test_gif_export_has_frames(walk, tmp_path):
     out = amble.animate(walk, tmp_path / "walk.gif", fps=10)
     with Image.open(out) as im:
         assert im.n_frames >= 10
+
+
+def test_unknown_file_formats_are_user_errors(tmp_path) -> None:
+    import matplotlib.pyplot as plt
+
+    from amble.errors import AmbleError
+    from amble.viz import animate
+    from amble.viz.errors import VizError
+    from amble.viz.sweep_plots import _save
+
+    with pytest.raises(VizError, match="unknown animation format"):
+        animate(None, tmp_path / "walk.txt")  # type: ignore[arg-type]
+    fig = plt.figure()
+    with pytest.raises(AmbleError, match="must end with"):
+        _save(fig, tmp_path / "plot.txt")
+    plt.close(fig)

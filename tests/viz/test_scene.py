@@ -8,6 +8,8 @@ import math
 import numpy as np
 import pytest
 
+from amble.errors import AmbleError
+from amble.viz.errors import SceneError
 from amble.viz.scene import Box, Cylinder, Ground, Sphere, default_look, frames
 
 
@@ -151,3 +153,37 @@ def test_frames_validation() -> None:
         frames([Ground(), Ground()], pts, t)
     # Repeated times (an impact: before and after) are fine.
     frames(sphere, pts, np.array([0.0, 0.5, 0.5, 0.7, 1.0]))
+
+
+def test_errors_are_typed() -> None:
+    # SceneError is both an AmbleError (the CLI reports a user error) and a ValueError.
+    pts, t = _points()
+    for bad in (
+        lambda: Sphere("hip", -1.0),
+        lambda: Box(center=(0.0, 0.0), size=(1.0, 1.0, 1.0)),
+        lambda: frames([Sphere("knee", 0.1)], pts, t),
+        lambda: frames(["not a shape"], pts, t),  # type: ignore[list-item]
+        lambda: default_look(["hip"], [], {"hip": -1.0}),
+    ):
+        with pytest.raises(SceneError) as info:
+            bad()
+        assert isinstance(info.value, AmbleError) and isinstance(info.value, ValueError)
+
+
+def test_shape_points_and_fields() -> None:
+    assert Sphere("hip", 0.1).points() == ("hip",)
+    assert Cylinder(["hip", "foot"], 0.1).points() == ("hip", "foot")  # type: ignore[arg-type]
+    assert Cylinder(["hip", "foot"], 0.1).between == ("hip", "foot")  # type: ignore[arg-type]
+    assert Box("foot", (1.0, 1.0, 1.0)).points() == ("foot",)
+    assert Box((0, 0, 1), (1, 1, 1)).points() == ()  # type: ignore[arg-type]
+    assert Box((0, 0, 1), (1, 1, 1)).center == (0.0, 0.0, 1.0)  # type: ignore[arg-type]
+    assert Ground().points() == ()
+    assert Ground(0.1).to_dict((-1.0, 2.0)) == {
+        "type": "ground", "slope": 0.1, "width": 2.0, "color": [0.86, 0.88, 0.91],
+        "opacity": 1.0, "grid": 0.1, "extent": [-1.0, 2.0],
+    }
+    # Shapes stay frozen, comparable and hashable dataclasses.
+    assert Sphere("hip", 0.1) == Sphere(at="hip", radius=0.1)
+    assert len({Sphere("hip", 0.1), Sphere("hip", 0.1)}) == 1
+    with pytest.raises(AttributeError):
+        Sphere("hip", 0.1).radius = 2.0  # type: ignore[misc]

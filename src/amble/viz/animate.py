@@ -9,11 +9,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import AmbleError
 from ..modelling.hybrid import HybridSystem
 from ..modelling.walker import Walker
 from ..simulation.trajectory import Trajectory
-from .scene import Ground, Sphere, default_look, frames
+from .errors import ExportError, SceneError, VizError
+from .scene import Cylinder, Ground, Shape, Sphere, default_look, frames
 
 
 def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] | None = None) -> list[Any]:
@@ -22,6 +22,9 @@ def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] 
     slope = _slope(system, params)
     if look:
         shapes = list(look)
+        for s in shapes:
+            if not isinstance(s, Shape):
+                raise SceneError(f"look: not a shape (Sphere, Cylinder, Box or Ground): {s!r}")
         if not any(isinstance(s, Ground) for s in shapes):
             shapes.insert(0, Ground(slope=slope))
         return shapes
@@ -55,19 +58,9 @@ def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = N
     step_idx = np.searchsorted([e.t for e in traj.step_events], times, side="right")
     hip = system.hip if isinstance(system, Walker) else None
     follow = hip if hip in pts else None
-    used = {n for s in shapes for n in _names(s)}
+    used = {n for s in shapes for n in s.points()}
     pts = {n: np.nan_to_num(v) for n, v in pts.items() if n in used or n == follow}
     return frames(shapes, pts, times, follow=follow, labels={"step": step_idx.tolist()})
-
-
-def _names(shape: Any) -> list[str]:
-    out = []
-    for attr in ("at", "center"):
-        v = getattr(shape, attr, None)
-        if isinstance(v, str):
-            out.append(v)
-    out += list(getattr(shape, "between", ()) or ())
-    return out
 
 
 def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None) -> Path:
@@ -82,7 +75,7 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
         return write_html(path, scene_of(traj, fps, look), title=f"amble — {traj.system.name}")
     if suffix in (".gif", ".mp4"):
         return _movie(traj, path, fps=min(fps, 30.0), look=look)
-    raise AmbleError(f"unknown animation format {path.suffix!r}: use .html, .gif or .mp4")
+    raise VizError(f"unknown animation format {path.suffix!r}: use .html, .gif or .mp4")
 
 
 def _movie(traj: Trajectory, path: Path, fps: float, look: Sequence[Any] | None) -> Path:
@@ -96,6 +89,8 @@ def _movie(traj: Trajectory, path: Path, fps: float, look: Sequence[Any] | None)
 
     times, pts = traj.resample(fps)
     shapes = look_of(system, traj.parameters, look)
+    links = [s for s in shapes if isinstance(s, Cylinder)]
+    balls = [s for s in shapes if isinstance(s, Sphere)]
     views = [(0, 2, "side (x–z)")] + ([(1, 2, "front (y–z)")] if system.dims == 3 else [])
     fig, axes = plt.subplots(1, len(views), figsize=(5 * len(views), 4), squeeze=False)
     allp = np.concatenate([np.nan_to_num(v) for v in pts.values()])
@@ -110,19 +105,18 @@ def _movie(traj: Trajectory, path: Path, fps: float, look: Sequence[Any] | None)
         if i == 0:
             xs = np.array([lo[0], hi[0]])
             ax.plot(xs, -np.tan(slope) * xs, color="0.5")
-        lines = [ax.plot([], [], "-", color="0.4", lw=2)[0] for s in shapes if hasattr(s, "between")]
-        dots = [ax.plot([], [], "o", color=getattr(s, "color", (0.2, 0.4, 0.8)), ms=4 + 60 * s.radius)[0]
-                for s in shapes if isinstance(getattr(s, "at", None), str)]
+        lines = [ax.plot([], [], "-", color="0.4", lw=2)[0] for _ in links]
+        dots = [ax.plot([], [], "o", color=s.color, ms=4 + 60 * s.radius)[0] for s in balls]
         artists.append((i, j, lines, dots))
 
     def draw(f: int):
         out = []
         for i, j, lines, dots in artists:
-            for ln, s in zip(lines, [s for s in shapes if hasattr(s, "between")]):
+            for ln, s in zip(lines, links):
                 a, b = pts[s.between[0]][f], pts[s.between[1]][f]
                 ln.set_data([a[i], b[i]], [a[j], b[j]])
                 out.append(ln)
-            for d, s in zip(dots, [s for s in shapes if isinstance(getattr(s, "at", None), str)]):
+            for d, s in zip(dots, balls):
                 d.set_data([pts[s.at][f][i]], [pts[s.at][f][j]])
                 out.append(d)
         return out
@@ -134,6 +128,6 @@ def _movie(traj: Trajectory, path: Path, fps: float, look: Sequence[Any] | None)
         try:
             anim.save(path, fps=fps)
         except (ValueError, RuntimeError, FileNotFoundError) as e:
-            raise AmbleError(f"cannot write {path.name}: MP4 needs ffmpeg ({e}); use .gif or .html") from None
+            raise ExportError(f"cannot write {path.name}: MP4 needs ffmpeg ({e}); use .gif or .html") from None
     plt.close(fig)
     return path

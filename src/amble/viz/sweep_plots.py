@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from .errors import VizError
+
 UNITS = {"slope": "rad", "mh": "kg", "m": "kg", "a": "m", "b": "m", "g": "m/s²", "l": "m", "r": "m"}
 _SUFFIXES = (".png", ".svg", ".pdf")
 
@@ -38,9 +40,7 @@ def _label(name: str) -> str:
 def _save(fig: Any, path: str | os.PathLike) -> Path:
     p = Path(path)
     if p.suffix.lower() not in _SUFFIXES:
-        from ..errors import StateError
-
-        raise StateError(f"plot file {str(p)!r} must end with one of {', '.join(_SUFFIXES)}")
+        raise VizError(f"plot file {str(p)!r} must end with one of {', '.join(_SUFFIXES)}")
     fig.savefig(p, dpi=120, bbox_inches="tight")
     _plt().close(fig)
     return p

@@ -1,0 +1,154 @@
+"""Scene building: :func:`frames` combines shapes and per-frame point positions into the
+JSON-serialisable ``amble.scene/1`` scene (described in :mod:`amble.viz.scene`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .errors import SceneError
+from .shapes import DIGITS, Box, Ground, Shape, check_name, rounded
+
+__all__ = ["FORMAT", "frames"]
+
+FORMAT = "amble.scene/1"
+
+
+def frames(
+    shapes: Sequence[Shape],
+    points: Mapping[str, np.ndarray],
+    times: np.ndarray,
+    *,
+    follow: str | None = None,
+    labels: Mapping[str, Sequence[Any]] | None = None,
+) -> dict[str, Any]:
+    """Build the JSON-serialisable scene the viewer animates.
+
+    Args:
+        shapes: the look: :class:`Sphere`, :class:`Cylinder`, :class:`Box` and at
+            most one :class:`Ground`.
+        points: world positions per point name, arrays of shape ``(F, 3)`` in
+            metres (``(F, 2)`` is read as ``(x, z)`` of a planar model, y = 0).
+        times: the ``F`` frame times in seconds, non-decreasing (equal
+            neighbours are allowed, e.g. just before and after an impact).
+        follow: a point name the camera can track, typically the hip.
+        labels: extra per-frame values shown next to the clock, e.g.
+            ``{"step": step_index}``; each a sequence of ``F`` numbers or strings.
+
+    Returns:
+        The scene dictionary described in :mod:`amble.viz.scene`.
+
+    Raises:
+        SceneError: a shape or ``follow`` names a point missing from ``points``,
+            arrays have the wrong shape or length, values are not finite, or
+            times decrease.
+    """
+    t = np.asarray(times, dtype=float)
+    if t.ndim != 1 or t.size == 0:
+        raise SceneError(f"frames: times must be a non-empty 1-D array, got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise SceneError("frames: times must be finite")
+    if np.any(np.diff(t) < 0):
+        raise SceneError("frames: times must be non-decreasing")
+    n = t.size
+
+    grounds = [s for s in shapes if isinstance(s, Ground)]
+    if len(grounds) > 1:
+        raise SceneError(f"frames: at most one Ground, got {len(grounds)}")
+    for s in shapes:
+        if not isinstance(s, Shape):
+            raise SceneError(f"frames: not a shape: {s!r}")
+
+    needed: list[str] = []
+    for s in shapes:
+        needed.extend(s.points())
+    if follow is not None:
+        needed.append(check_name(follow, "follow", "frames"))
+    needed = list(dict.fromkeys(needed))  # keep order, drop repeats
+    missing = [p for p in needed if p not in points]
+    if missing:
+        raise SceneError(
+            f"frames: unknown point name(s) {', '.join(map(repr, missing))}; "
+            f"points given: {', '.join(map(repr, points)) or 'none'}"
+        )
+
+    arrays = {name: _as_xyz(name, points[name], n) for name in needed}
+
+    if arrays:
+        stacked = np.concatenate(list(arrays.values()), axis=0)
+        lo, hi = stacked.min(axis=0), stacked.max(axis=0)
+    else:
+        static = [s.center for s in shapes if isinstance(s, Box)]
+        lo = np.min(static, axis=0) if static else np.zeros(3)
+        hi = np.max(static, axis=0) if static else np.zeros(3)
+
+    shape_dicts: list[dict[str, Any]] = []
+    for s in shapes:
+        if isinstance(s, Ground):
+            shape_dicts.append(s.to_dict(_ground_extent(s.slope, lo[0], hi[0])))
+        else:
+            shape_dicts.append(s.to_dict())
+
+    scene: dict[str, Any] = {
+        "format": FORMAT,
+        "times": _flat(t),
+        "points": {name: _flat(a) for name, a in arrays.items()},
+        "shapes": shape_dicts,
+        "follow": follow,
+        "labels": _labels(labels, n),
+        "bounds": {"min": _flat(lo), "max": _flat(hi)},
+    }
+    return scene
+
+
+def _as_xyz(name: str, value: np.ndarray, n: int) -> np.ndarray:
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 2 and a.shape[1] == 2:
+        # Planar models give (x, z); they live in the y = 0 plane.
+        a = np.column_stack([a[:, 0], np.zeros(len(a)), a[:, 1]])
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise SceneError(f"frames: point {name!r} must have shape (F, 3), got {a.shape}")
+    if a.shape[0] != n:
+        raise SceneError(f"frames: point {name!r} has {a.shape[0]} frames, times has {n}")
+    if not np.all(np.isfinite(a)):
+        raise SceneError(f"frames: point {name!r} has non-finite positions")
+    return a
+
+
+def _ground_extent(slope: float, x_min: float, x_max: float) -> tuple[float, float]:
+    """Along-slope range that covers the motion, with room to spare on both ends."""
+    span = float(x_max - x_min)
+    margin = max(3.0, 0.5 * span)
+    c = math.cos(slope)
+    # The along-slope coordinate s of a point at x is x / cos(slope).
+    return ((x_min - margin) / c, (x_max + margin) / c)
+
+
+def _labels(labels: Mapping[str, Sequence[Any]] | None, n: int) -> dict[str, list[Any]]:
+    out: dict[str, list[Any]] = {}
+    for key, values in (labels or {}).items():
+        vals = list(values)
+        if len(vals) != n:
+            raise SceneError(f"frames: label {key!r} has {len(vals)} values, times has {n}")
+        out[str(key)] = [_label_value(v) for v in vals]
+    return out
+
+
+def _label_value(v: Any) -> Any:
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return rounded(float(v)) if math.isfinite(v) else None
+    return str(v)
+
+
+def _flat(a: np.ndarray) -> list[float]:
+    """Row-major flat list of rounded floats, integral values written as ints."""
+    r = np.round(np.asarray(a, dtype=float).ravel(), DIGITS) + 0.0
+    # JSON "0" is shorter than "0.0": planar models have a whole column of zeros.
+    return [int(v) if v.is_integer() else v for v in r.tolist()]
