@@ -18,6 +18,7 @@ from ..derivation.equations import Equations, derive
 from ..errors import ModelError
 from ..modelling.hybrid import Explicit, HybridSystem, Impact, Lock, target_exprs
 from ..modelling.model import Model, t
+from . import abi
 
 
 class _Printer(C99CodePrinter):
@@ -124,6 +125,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
     out: list[str] = []
     w = out.append
     w('#include "amble_core.h"\n')
+    w(abi.c_header())
     w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
     w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")

@@ -27,19 +27,17 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ..errors import CompileError, ModelError
+from ..errors import CompileError, ModelError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..version import __version__
+from . import abi
 
 _C_DIR = Path(str(resources.files("amble.backend") / "_c"))
 _LOADED: dict[str, Kernels] = {}
 
 _dptr = ctypes.POINTER(ctypes.c_double)
 _iptr = ctypes.POINTER(ctypes.c_int)
-_lptr = ctypes.POINTER(ctypes.c_long)
-
-#: Index of the state vector inside the resumable context array (CX_X in hybrid.c).
-CTX_X = 16
+_i64ptr = ctypes.POINTER(ctypes.c_int64)
 
 
 def cache_dir() -> Path:
@@ -156,12 +154,16 @@ class Kernels:
         except OSError as e:
             raise CompileError(f"cannot load compiled model {so}: {e}") from None
         self._lib = lib
-        info = np.zeros(6, dtype=np.int64)
-        lib.amble_info.argtypes = [_lptr]
-        lib.amble_info(info.ctypes.data_as(_lptr))
-        self.n_modes, self.nx_max, self.n_tr, self.n_points, _, ctx_x = (int(v) for v in info)
-        if ctx_x != CTX_X:
-            raise CompileError("compiled model and loader disagree on the context layout; clear the cache")
+        info = np.zeros(8, dtype=np.int64)
+        lib.amble_info.argtypes = [_i64ptr]
+        lib.amble_info(info.ctypes.data_as(_i64ptr))
+        self.n_modes, self.nx_max, self.n_tr, self.n_points = (int(v) for v in info[:4])
+        self.layout = int(info[6])
+        if self.layout != abi.LAYOUT:
+            raise CompileError(
+                f"compiled model {so} has interface layout {self.layout}, this amble expects {abi.LAYOUT}: "
+                f"it is stale; clear the cache ({so.parent})"
+            )
         lib.amble_simulate.restype = ctypes.c_int
         # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
         # evaluation, and building typed ctypes pointers costs more than a walking step.
@@ -172,8 +174,8 @@ class Kernels:
         lib.amble_reset.restype = ctypes.c_int
         lib.amble_reset.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _iptr]
         lib.amble_dynamics.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr, _dptr]
-        lib.amble_rows_energy.argtypes = [ctypes.c_long, _dptr, _iptr, _dptr, _dptr, _dptr]
-        lib.amble_rows_kinematics.argtypes = [ctypes.c_long, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
+        lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
+        lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
         self.simulate_raw = lib.amble_simulate
 
     # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
@@ -228,14 +230,14 @@ class Kernels:
         return mode, out[: self.meta["nx"][target.value]].copy()
 
     def energy_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
-        t, modes, x = _rows(t, modes, x, self.nx_max)
+        t, modes, x = _rows(t, modes, x, self.nx_max, self.n_modes)
         out = np.zeros((len(t), 2))
         self._lib.amble_rows_energy(len(t), _p(t), modes.ctypes.data_as(_iptr), _p(x), _p(p), _p(out))
         return out
 
     def kinematics_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray
                         ) -> tuple[np.ndarray, np.ndarray]:
-        t, modes, x = _rows(t, modes, x, self.nx_max)
+        t, modes, x = _rows(t, modes, x, self.nx_max, self.n_modes)
         pos = np.zeros((len(t), self.n_points, 3))
         vel = np.zeros((len(t), self.n_points, 3))
         self._lib.amble_rows_kinematics(len(t), _p(t), modes.ctypes.data_as(_iptr), _p(x), _p(p), _p(pos), _p(vel))
@@ -253,12 +255,21 @@ def _vec(x: Any, n: int) -> np.ndarray:
     return x
 
 
-def _rows(t: Any, modes: Any, x: Any, nx_max: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _rows(t: Any, modes: Any, x: Any, nx_max: int, n_modes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rows of (time, mode, state) for the row-wise kernels: equal lengths, modes in range, states
+    padded to ``nx_max``."""
     t = np.ascontiguousarray(t, dtype=float).ravel()
     modes = np.ascontiguousarray(modes, dtype=np.int32).ravel()
     x = np.asarray(x, dtype=float)
     if x.ndim == 1:
         x = x[None, :]
+    if x.ndim != 2 or x.shape[1] > nx_max:
+        raise StateError(f"states must be rows of at most {nx_max} entries, got shape {x.shape}")
+    if not (len(t) == len(modes) == x.shape[0]):
+        raise StateError(f"row counts differ: {len(t)} times, {len(modes)} modes, {x.shape[0]} states")
+    if len(modes) and (modes.min() < 0 or modes.max() >= n_modes):
+        bad = int(modes[(modes < 0) | (modes >= n_modes)][0])
+        raise StateError(f"mode index {bad} out of range (the system has {n_modes} modes)")
     if x.shape[1] < nx_max:
         x = np.hstack([x, np.full((x.shape[0], nx_max - x.shape[1]), np.nan)])
     return t, modes, np.ascontiguousarray(x)
