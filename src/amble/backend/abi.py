@@ -67,5 +67,19 @@ def _layout_text() -> str:
     return ";".join(parts)
 
 
-#: A 63-bit fingerprint of the whole layout; the compiled library reports the one it was built with.
+#: A 60-bit fingerprint of the whole layout; the compiled library reports the one it was built with.
 LAYOUT = int(hashlib.sha256(_layout_text().encode()).hexdigest()[:15], 16)
+
+
+def c_header(layout: int | None = None) -> str:
+    """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*`` and
+    ``AMBLE_LAYOUT`` (default :data:`LAYOUT`), written into every generated translation unit
+    before the engine is included. Integer arrays shared with NumPy int64 are ``int64_t``."""
+    lines = ["/* Python <-> C interface, generated from amble/backend/abi.py; do not edit. */",
+             "#include <stdint.h>"]
+    lines += [f"#define ST_{name} {code}" for code, name, _ in STATUS]
+    lines += [f"#define CX_{name} {i}" for name, i in CTX.items()] + [f"#define CX_X {CTX_X}"]
+    lines += [f"#define OP_{name} {i}" for name, i in OPT.items()]
+    lines += [f"#define IO_{name} {i}" for name, i in IOPT.items()]
+    lines.append(f"#define AMBLE_LAYOUT {LAYOUT if layout is None else layout}LL")
+    return "\n".join(lines) + "\n"

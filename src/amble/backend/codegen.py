@@ -3,8 +3,11 @@
 Every kernel is emitted from sympy expressions after common-subexpression elimination, with
 coordinates read from the state array ``x`` (``x[i]`` = qᵢ, ``x[n+i]`` = q̇ᵢ) and parameters
 from ``p`` — parameters are run-time inputs, so changing a mass or a slope recompiles nothing.
-The generated unit includes ``hybrid.c``, the integrator and event loop, so the whole walking
-step is compiled together and the right-hand side is inlined into the integrator.
+Nothing symbolic is derived here: the equations of motion come from
+:mod:`amble.derivation.equations`, impact and lock maps from :mod:`amble.derivation.impact`, and
+the interface codes from :func:`amble.backend.abi.c_header`. The generated unit includes
+``hybrid.c``, the integrator and event loop, so the whole walking step is compiled together and
+the right-hand side is inlined into the integrator.
 """
 
 from __future__ import annotations
@@ -15,9 +18,10 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..derivation.equations import Equations, derive
-from ..errors import ModelError
-from ..modelling.hybrid import Explicit, HybridSystem, Impact, Lock, target_exprs
+from ..derivation.impact import impulse_data
+from ..modelling.hybrid import Explicit, HybridSystem, target_exprs
 from ..modelling.model import Model, t
+from . import abi
 
 
 class _Printer(C99CodePrinter):
@@ -76,37 +80,6 @@ def _bool_block(expr: sp.Basic, names: dict[sp.Symbol, str]) -> str:
     return pr.doprint(expr)
 
 
-def _extended_impact_data(model: Model, eq: Equations, point: str) -> tuple[sp.Matrix, sp.Matrix]:
-    """Mass matrix and contact Jacobian of the model extended with its base (stance-foot) position.
-
-    Extended coordinates are ``(q, b)``, every position shifted by ``b``: with ``S = Σ mᵢ Jᵢᵀ`` and
-    total mass ``mₜ``, ``M_e = [[M, S], [Sᵀ, mₜ I]]`` and the impacting point has ``J = [J_c, I]``.
-    """
-    if model._k_override is not None or model._l_override is not None:
-        raise ModelError(
-            f"model {model.name!r}: an Impact reset needs the kinetic energy from point masses "
-            "(K or L was given outright); give an Explicit reset instead"
-        )
-    # Added kinetic terms (rotational inertia) do not depend on the base translation, so they
-    # stay in the q-block M and contribute nothing to the base blocks.
-    n, d = len(model.q), model.dims
-    S = sp.zeros(n, d)
-    mt = sp.Integer(0)
-    for name, m in model.masses.items():
-        J = model.points[name].jacobian(model.q)
-        S += m * J.T
-        mt += m
-    Me = sp.zeros(n + d, n + d)
-    Me[:n, :n] = eq.M
-    Me[:n, n:] = S
-    Me[n:, :n] = S.T
-    Me[n:, n:] = mt * sp.eye(d)
-    Jc = sp.zeros(d, n + d)
-    Jc[:, :n] = model.points[point].jacobian(model.q)
-    Jc[:, n:] = sp.eye(d)
-    return Me, Jc
-
-
 def generate(system: HybridSystem) -> tuple[str, dict]:
     """Generate the C source of a system; returns (source, metadata for the loader)."""
     params = list(system.parameters)
@@ -124,6 +97,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
     out: list[str] = []
     w = out.append
     w('#include "amble_core.h"\n')
+    w(abi.c_header())
     w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
     w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
@@ -285,16 +259,9 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
         body += _block([f"y[{j}]" for j in range(2 * nd)], qn + vn, nm)
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
         return head + body + "}\n"
-    if isinstance(reset, Impact):
-        Me, Jc = _extended_impact_data(m, eq, reset.point)
-    elif isinstance(reset, Lock):
-        Me = eq.M
-        Jc = sp.Matrix([[sp.diff(sp.sympify(reset.constraint), qi) for qi in m.q]])
-    else:  # pragma: no cover - validated earlier
-        raise ModelError(f"{what}: unsupported reset {reset!r}")
+    imp = impulse_data(m, eq, reset, dst.model, what)  # Impact or Lock (validated when declared)
+    Me, Jc, qn, dq = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
     ne, nc = Me.shape[0], Jc.shape[0]
-    qn = target_exprs(dst.model, reset.relabel, what, source=m)
-    dq = sp.Matrix(qn).jacobian(m.q)  # velocity map of the relabelling
     body += f"    double Me[{ne * ne}], Jc[{nc * ne}], v[{ne}], qn[{nd}], T[{nd * n}];\n"
     tg = [f"Me[{a * ne + b}]" for a in range(ne) for b in range(ne)]
     ex = [Me[a, b] for a in range(ne) for b in range(ne)]

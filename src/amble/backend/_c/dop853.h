@@ -1,0 +1,181 @@
+/* DOP853 (Hairer, Norsett & Wanner) as implemented in SciPy: same tableau, error norm, step-size
+ * control and 7th-order dense output, so results can be compared step for step. Also the cheap
+ * cubic Hermite interpolant through both step ends used to screen guards.
+ *
+ * Needs from the including unit: the ST_* codes (generated from abi.py), NXMAX and
+ *   int rhs(int mode, double t, const double *x, const double *p, double *dx);
+ */
+#ifndef AMBLE_DOP853_H
+#define AMBLE_DOP853_H
+#include "dop853_tableau.h"
+
+typedef struct {
+    int n;
+    double t_old, h;
+    double y_old[NXMAX], y[NXMAX], f_old[NXMAX], f[NXMAX];
+    double K[DOP_STAGES_EXT][NXMAX];
+    double F[DOP_INTERP][NXMAX];
+    int dense_ready;
+} Dop;
+
+static int all_finite(int n, const double *x) {
+    for (int i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+static double rms_norm(int n, const double *v) {
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += v[i] * v[i];
+    return sqrt(s / n);
+}
+
+/* Initial step size as in Hairer's / SciPy's select_initial_step. */
+static double initial_step(int mode, double t, const double *y, const double *f, const double *p,
+                           double t_bound, double max_step, double rtol, double atol, int n) {
+    double sc[NXMAX], tmp[NXMAX], y1[NXMAX], f1[NXMAX];
+    double interval = fabs(t_bound - t);
+    if (interval == 0.0) return 0.0;
+    for (int i = 0; i < n; ++i) sc[i] = atol + fabs(y[i]) * rtol;
+    for (int i = 0; i < n; ++i) tmp[i] = y[i] / sc[i];
+    double d0 = rms_norm(n, tmp);
+    for (int i = 0; i < n; ++i) tmp[i] = f[i] / sc[i];
+    double d1 = rms_norm(n, tmp);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (h0 > interval) h0 = interval;
+    for (int i = 0; i < n; ++i) y1[i] = y[i] + h0 * f[i];
+    if (rhs(mode, t + h0, y1, p, f1)) return 1e-6;
+    for (int i = 0; i < n; ++i) tmp[i] = (f1[i] - f[i]) / sc[i];
+    double d2 = rms_norm(n, tmp) / h0;
+    double h1;
+    if (d1 <= 1e-15 && d2 <= 1e-15) h1 = fmax(1e-6, h0 * 1e-3);
+    else h1 = pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
+    double h = fmin(100 * h0, h1);
+    h = fmin(h, interval);
+    return fmin(h, max_step);
+}
+
+/* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status. */
+static int dop_step(Dop *s, int mode, const double *p, double t_bound, double rtol, double atol,
+                    double max_step, double *h_abs) {
+    const int n = s->n;
+    const double t = s->t_old;
+    double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
+    double ha = *h_abs;
+    if (ha > max_step) ha = max_step;
+    if (ha < min_step) ha = min_step;
+    int rejected = 0, saw_nan = 0;
+    double ytmp[NXMAX];
+    for (;;) {
+        if (ha < min_step) return saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
+        double t_new = t + ha;
+        if (t_new > t_bound) t_new = t_bound;
+        double h = t_new - t;
+        ha = fabs(h);
+        for (int i = 0; i < n; ++i) s->K[0][i] = s->f_old[i];
+        int err = 0;
+        for (int st = 1; st < DOP_STAGES && !err; ++st) {
+            const double *a = DOP_A + st * DOP_STAGES_EXT;
+            for (int i = 0; i < n; ++i) {
+                double acc = 0.0;
+                for (int j = 0; j < st; ++j) acc += a[j] * s->K[j][i];
+                ytmp[i] = s->y_old[i] + h * acc;
+            }
+            err = rhs(mode, t + DOP_C[st] * h, ytmp, p, s->K[st]);
+        }
+        if (err) return ST_SINGULAR_MASS;
+        for (int i = 0; i < n; ++i) {
+            double acc = 0.0;
+            for (int j = 0; j < DOP_STAGES; ++j) acc += DOP_B[j] * s->K[j][i];
+            s->y[i] = s->y_old[i] + h * acc;
+        }
+        if (rhs(mode, t + h, s->y, p, s->K[DOP_STAGES])) return ST_SINGULAR_MASS;
+        double e5 = 0.0, e3 = 0.0;
+        for (int i = 0; i < n; ++i) {
+            double sc = atol + fmax(fabs(s->y_old[i]), fabs(s->y[i])) * rtol;
+            double a5 = 0.0, a3 = 0.0;
+            for (int j = 0; j <= DOP_STAGES; ++j) {
+                a5 += DOP_E5[j] * s->K[j][i];
+                a3 += DOP_E3[j] * s->K[j][i];
+            }
+            a5 /= sc;
+            a3 /= sc;
+            e5 += a5 * a5;
+            e3 += a3 * a3;
+        }
+        double error_norm;
+        if (e5 == 0.0 && e3 == 0.0) error_norm = 0.0;
+        else error_norm = ha * e5 / sqrt((e5 + 0.01 * e3) * n);
+        if (!isfinite(error_norm) || !all_finite(n, s->y)) {
+            saw_nan = 1;
+            ha *= 0.2;
+            rejected = 1;
+            continue;
+        }
+        if (error_norm < 1.0) {
+            double factor = error_norm == 0.0 ? 10.0 : fmin(10.0, 0.9 * pow(error_norm, -1.0 / 8.0));
+            if (rejected && factor > 1.0) factor = 1.0;
+            *h_abs = ha * factor;
+            s->h = h;
+            for (int i = 0; i < n; ++i) s->f[i] = s->K[DOP_STAGES][i];
+            s->dense_ready = 0;
+            return 0;
+        }
+        ha *= fmax(0.2, 0.9 * pow(error_norm, -1.0 / 8.0));
+        rejected = 1;
+    }
+}
+
+/* 7th-order continuous extension of the last step (three extra stages). */
+static int dop_dense_prepare(Dop *s, int mode, const double *p) {
+    if (s->dense_ready) return 0;
+    const int n = s->n;
+    const double h = s->h;
+    double ytmp[NXMAX];
+    for (int st = DOP_STAGES + 1; st < DOP_STAGES_EXT; ++st) {
+        const double *a = DOP_A + st * DOP_STAGES_EXT;
+        for (int i = 0; i < n; ++i) {
+            double acc = 0.0;
+            for (int j = 0; j < st; ++j) acc += a[j] * s->K[j][i];
+            ytmp[i] = s->y_old[i] + h * acc;
+        }
+        if (rhs(mode, s->t_old + DOP_C[st] * h, ytmp, p, s->K[st])) return ST_SINGULAR_MASS;
+    }
+    for (int i = 0; i < n; ++i) {
+        double dy = s->y[i] - s->y_old[i];
+        s->F[0][i] = dy;
+        s->F[1][i] = h * s->f_old[i] - dy;
+        s->F[2][i] = 2.0 * dy - h * (s->f[i] + s->f_old[i]);
+        for (int r = 0; r < 4; ++r) {
+            double acc = 0.0;
+            for (int j = 0; j < DOP_STAGES_EXT; ++j) acc += DOP_D[r * DOP_STAGES_EXT + j] * s->K[j][i];
+            s->F[3 + r][i] = h * acc;
+        }
+    }
+    s->dense_ready = 1;
+    return 0;
+}
+
+static void dop_dense_eval(const Dop *s, double t, double *out) {
+    const int n = s->n;
+    double x = (t - s->t_old) / s->h;
+    for (int i = 0; i < n; ++i) {
+        double y = 0.0;
+        for (int k = DOP_INTERP - 1, c = 0; k >= 0; --k, ++c) {
+            y += s->F[k][i];
+            y *= (c % 2 == 0) ? x : (1.0 - x);
+        }
+        out[i] = y + s->y_old[i];
+    }
+}
+
+/* Cubic Hermite through both step ends: cheap, for spotting sign changes inside a step. */
+static void hermite_eval(const Dop *s, double theta, double *out) {
+    const double h = s->h;
+    double t2 = theta * theta, t3 = t2 * theta;
+    double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + theta, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+    for (int i = 0; i < s->n; ++i)
+        out[i] = h00 * s->y_old[i] + h10 * h * s->f_old[i] + h01 * s->y[i] + h11 * h * s->f[i];
+}
+
+#endif

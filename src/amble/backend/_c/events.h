@@ -1,0 +1,154 @@
+/* Event location inside one accepted integration step.
+ *
+ * A step is screened by sampling each guard of the mode at a few times inside it (a uniform grid
+ * plus, per guard, the extremum of the cubic through g and ġ at both ends) on the cheap Hermite
+ * interpolant; only if some guard changes sign in its direction is the 7th-order dense output
+ * built, the samples redone on it, and each bracketed crossing refined by the Illinois method.
+ * The event is the earliest crossing whose enabling condition holds there.
+ *
+ * Needs from the including unit: dop853.h, the ST_* codes, NTR, NSUB_MAX, MODE_NTR, MODE_TR0,
+ * TR_DIR and guards, guards_dot, enabled.
+ */
+#ifndef AMBLE_EVENTS_H
+#define AMBLE_EVENTS_H
+
+#define NTR1 (NTR > 0 ? NTR : 1)
+#define NSAMP_MAX (NSUB_MAX + 1 + 2 * NTR)
+
+static int crosses(int dir, double ga, double gb) {
+    if (dir < 0) return ga > 0.0 && gb <= 0.0;
+    if (dir > 0) return ga < 0.0 && gb >= 0.0;
+    return (ga > 0.0 && gb <= 0.0) || (ga < 0.0 && gb >= 0.0);
+}
+
+/* Guard k of `mode` along the dense output at time t. */
+static double guard_at(const Dop *s, int mode, int k, double t, const double *p, double *xbuf) {
+    double g[NTR1];
+    dop_dense_eval(s, t, xbuf);
+    guards(mode, t, xbuf, p, g);
+    return g[k];
+}
+
+/* Root of guard k in [ta, tb] (crossing in direction dir) by the Illinois method on the dense
+ * output; returns a time on the far side of the crossing, within ~1e-14 relative. */
+static double locate(const Dop *s, int mode, int k, int dir, double ta, double ga, double tb,
+                     double gb, const double *p) {
+    double xbuf[NXMAX];
+    int side = 0;
+    double tol = 4e-16 * fmax(1.0, fmax(fabs(ta), fabs(tb)));
+    for (int it = 0; it < 200 && (tb - ta) > tol; ++it) {
+        double tm = (ga * tb - gb * ta) / (ga - gb);
+        if (!(tm > ta && tm < tb)) tm = 0.5 * (ta + tb);
+        double gm = guard_at(s, mode, k, tm, p, xbuf);
+        if (crosses(dir, ga, gm)) {
+            tb = tm; gb = gm;
+            if (side == -1) ga *= 0.5;
+            side = -1;
+        } else {
+            ta = tm; ga = gm;
+            if (side == 1) gb *= 0.5;
+            side = 1;
+        }
+    }
+    return tb;
+}
+
+/* Sample times θ ∈ [0, 1] inside a step of size h, sorted: a uniform grid of nsub intervals, plus
+ * for each guard the extremum of the cubic through g and ġ at both ends — so a guard that dips
+ * below zero and comes back within one step (two crossings) is still seen. Returns their number. */
+static int sample_times(double h, int ntr, int nsub, const double *g_old, const double *gd0,
+                        const double *g_new, const double *gd1, double *th) {
+    int ns = 0;
+    for (int j = 0; j <= nsub; ++j) th[ns++] = (double)j / nsub;
+    for (int k = 0; k < ntr; ++k) {
+        double a0 = g_old[k], a1 = h * gd0[k], b0 = g_new[k], b1 = h * gd1[k];
+        /* cubic c(θ) = a0 + a1 θ + c2 θ² + c3 θ³ matching values and slopes */
+        double c2 = 3 * (b0 - a0) - 2 * a1 - b1, c3 = 2 * (a0 - b0) + a1 + b1;
+        double A = 3 * c3, B = 2 * c2, C = a1;
+        double r[2];
+        int nr = 0;
+        double disc = B * B - 4 * A * C;
+        if (disc >= 0) { /* stable roots of A θ² + B θ + C (A may be ~0: a quadratic guard) */
+            double qq = -0.5 * (B + copysign(sqrt(disc), B));
+            if (qq != 0.0) r[nr++] = C / qq;
+            if (A != 0.0) r[nr++] = qq / A;
+        }
+        for (int q = 0; q < nr; ++q)
+            if (r[q] > 0.0 && r[q] < 1.0 && ns < NSAMP_MAX) th[ns++] = r[q];
+    }
+    for (int a = 1; a < ns; ++a) /* insertion sort: a handful of values */
+        for (int b = a; b > 0 && th[b - 1] > th[b]; --b) { double tmp = th[b]; th[b] = th[b - 1]; th[b - 1] = tmp; }
+    return ns;
+}
+
+/* Guards at the inner sample times, on the Hermite interpolant (dense = 0) or the dense output. */
+static void sample_guards(const Dop *s, int mode, const double *p, double t, int ns, const double *th,
+                          int dense, double gs[][NTR1]) {
+    double xs[NXMAX];
+    for (int j = 1; j < ns - 1; ++j) {
+        if (dense) dop_dense_eval(s, t + s->h * th[j], xs);
+        else hermite_eval(s, th[j], xs);
+        guards(mode, t + s->h * th[j], xs, p, gs[j]);
+    }
+}
+
+/* Does any guard of the mode cross in its direction between two consecutive samples? */
+static int any_crossing(int ntr, int tr0, int ns, double gs[][NTR1]) {
+    for (int k = 0; k < ntr; ++k)
+        for (int j = 0; j + 1 < ns; ++j)
+            if (crosses(TR_DIR[tr0 + k], gs[j][k], gs[j + 1][k])) return 1;
+    return 0;
+}
+
+/* The earliest enabled crossing over the samples (dense output ready): returns its guard index
+ * within the mode (or -1) and sets *t_ev and x_ev. */
+static int first_enabled_crossing(const Dop *s, int mode, const double *p, double t, double t_new, int ns,
+                                  const double *th, double gs[][NTR1], double *t_ev, double *x_ev) {
+    const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+    int ev_k = -1;
+    for (int k = 0; k < ntr; ++k) {
+        int dir = TR_DIR[tr0 + k];
+        for (int j = 0; j + 1 < ns; ++j) {
+            double ta = t + s->h * th[j], tb = (j + 2 == ns) ? t_new : t + s->h * th[j + 1];
+            if (ta >= *t_ev) break;
+            if (tb <= ta || !crosses(dir, gs[j][k], gs[j + 1][k])) continue;
+            double tr = locate(s, mode, k, dir, ta, gs[j][k], tb, gs[j + 1][k], p);
+            if (tr >= *t_ev) break;
+            double xr[NXMAX];
+            if (tr >= t_new) { tr = t_new; for (int i = 0; i < s->n; ++i) xr[i] = s->y[i]; }
+            else dop_dense_eval(s, tr, xr);
+            if (enabled(tr0 + k, tr, xr, p)) {
+                *t_ev = tr;
+                ev_k = k;
+                for (int i = 0; i < s->n; ++i) x_ev[i] = xr[i];
+                break;
+            }
+        }
+    }
+    return ev_k;
+}
+
+/* Event of the step just taken from (t, g_old, gd_old) to (t_new, g_new): fills gd_new (ġ at
+ * t_new), sets *ev_k (guard index within the mode, or -1), *t_ev and x_ev. Returns 0 or
+ * ST_SINGULAR_MASS (the dense output could not be built). */
+static int find_event(Dop *s, int mode, const double *p, int nsub, double t, double t_new,
+                      const double *g_old, const double *gd_old, const double *g_new, double *gd_new,
+                      int *ev_k, double *t_ev, double *x_ev) {
+    const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+    *ev_k = -1;
+    *t_ev = INFINITY;
+    if (ntr <= 0) return 0;
+    double th[NSAMP_MAX];
+    guards_dot(mode, t_new, s->y, s->f, p, gd_new);
+    const int ns = sample_times(s->h, ntr, nsub, g_old, gd_old, g_new, gd_new, th);
+    double gs[NSAMP_MAX][NTR1];
+    for (int k = 0; k < ntr; ++k) { gs[0][k] = g_old[k]; gs[ns - 1][k] = g_new[k]; }
+    sample_guards(s, mode, p, t, ns, th, 0, gs);
+    if (!any_crossing(ntr, tr0, ns, gs)) return 0;
+    if (dop_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
+    sample_guards(s, mode, p, t, ns, th, 1, gs);
+    *ev_k = first_enabled_crossing(s, mode, p, t, t_new, ns, th, gs, t_ev, x_ev);
+    return 0;
+}
+
+#endif

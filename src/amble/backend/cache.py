@@ -1,0 +1,219 @@
+"""The on-disk cache of compiled systems: where it is, what a library's key covers, how it is built.
+
+A library is cached under ``<name>-<key>.so`` with its loader metadata in ``<name>-<key>.json``.
+The key is a hash of everything that shapes the compiled library:
+
+* the system's *structure* — symbolic positions, masses, energies, forces, guards and resets,
+  parameter names — but never parameter values or defaults, which are run-time inputs;
+* the sources that generate and compile it: the C engine (``backend/_c``), the backend, the
+  derivation, and the modelling types that feed them (``modelling/{model,hybrid,walker}.py``),
+  and the amble version;
+* the toolchain: ``$CC`` (or the compiler found), its ``--version`` output, and ``$AMBLE_CFLAGS``.
+
+The package sources are hashed once per process and the compiler identity once per compiler.
+A system's structural hash is computed once per system object: systems are mutable dataclasses
+but are declared once and not changed after their first build. A cheap fingerprint (the mode
+objects and the number of transitions) is checked on every call, so adding a transition or
+replacing a mode after a build is still caught; editing a mode's model in place after a build is
+not (build a new system instead).
+
+Builds write to a temporary file and rename it into place, so concurrent processes (Dask workers)
+can build the same model safely. The cache lives in ``$AMBLE_CACHE_DIR``, else
+``$XDG_CACHE_HOME/amble``, else ``~/.cache/amble``. ``$CC`` picks the C compiler (default
+``cc``); a C99 compiler is the one system requirement of amble.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import weakref
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import sympy as sp
+
+from ..errors import CompileError
+from ..modelling.hybrid import HybridSystem
+from ..version import __version__
+
+C_DIR = Path(str(resources.files("amble.backend") / "_c"))
+_PKG = Path(__file__).resolve().parents[1]
+
+#: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.
+_SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/model.py", "modelling/hybrid.py",
+                 "modelling/walker.py")
+
+#: id(system) → (weak reference, fingerprint, structural hash)
+_STRUCT: dict[int, tuple[weakref.ref, tuple, str]] = {}
+
+
+def cache_dir() -> Path:
+    """The cache directory (created if missing)."""
+    env = os.environ.get("AMBLE_CACHE_DIR")
+    if env:
+        d = Path(env)
+    else:
+        xdg = os.environ.get("XDG_CACHE_HOME")
+        d = Path(xdg) / "amble" if xdg else Path.home() / ".cache" / "amble"
+    d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
+def source_files() -> list[Path]:
+    """The C engine and the Python sources that generate a library."""
+    files = sorted(f for f in C_DIR.iterdir() if f.suffix in (".c", ".h"))
+    return files + sorted({f for pattern in _SOURCE_GLOBS for f in _PKG.glob(pattern)})
+
+
+@lru_cache(maxsize=1)
+def source_digest() -> str:
+    """Hash of the amble version and of every file of :func:`source_files` (once per process)."""
+    h = hashlib.sha256(__version__.encode())
+    for f in source_files():
+        h.update(f.name.encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def compiler() -> str:
+    """The C compiler command: ``$CC``, else the first of cc, gcc, clang on the PATH."""
+    return _find_compiler(os.environ.get("CC") or "", os.environ.get("PATH") or "")
+
+
+@lru_cache(maxsize=16)
+def _find_compiler(env_cc: str, path: str) -> str:
+    cc = env_cc or next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
+    if cc is None or shutil.which(cc.split()[0]) is None:
+        raise CompileError(
+            "no C compiler found: amble compiles each model to native code; install gcc or clang "
+            "(e.g. 'apt-get install gcc') or set $CC"
+        )
+    return cc
+
+
+def cflags() -> list[str]:
+    return os.environ.get("AMBLE_CFLAGS", "-O2").split()
+
+
+@lru_cache(maxsize=16)
+def compiler_identity(cc: str) -> str:
+    """``cc --version`` output (once per compiler command); empty if it cannot be run."""
+    try:
+        r = subprocess.run([*cc.split(), "--version"], capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    return r.stdout + r.stderr
+
+
+def toolchain() -> str:
+    """Compiler command, its identity and the flags, as one string."""
+    cc = compiler()
+    return "\0".join([cc, compiler_identity(cc), *cflags()])
+
+
+def _structure_digest(system: HybridSystem) -> str:
+    """Hash of the system's structure (not parameter values or defaults)."""
+    h = hashlib.sha256()
+    for name, m in system.modes.items():
+        parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]
+        parts += [m._k_terms, m._v_terms, m._k_override, m._v_override, m._l_override]
+        parts += [m._forces, m.gravity_vector]
+        h.update(sp.srepr(parts).encode())
+    for tr in system.transitions:
+        h.update(repr((tr.name, tr.source, tr.target, tr.terminal, tr.step)).encode())
+        h.update(sp.srepr([tr.guard.expr, tr.guard.direction, tr.guard.enabled]).encode())
+        h.update(sp.srepr(_reset_repr(tr.reset)).encode())
+    h.update(repr(list(system.parameters)).encode())
+    return h.hexdigest()
+
+
+def _reset_repr(reset: Any) -> list:
+    if reset is None:
+        return []
+    out: list[Any] = [type(reset).__name__]
+    for k, v in sorted(vars(reset).items()):
+        out.append(k)
+        if isinstance(v, dict):
+            out.append(sorted((str(a), b) for a, b in v.items()))
+        else:
+            out.append(v)
+    return out
+
+
+def _fingerprint(system: HybridSystem) -> tuple:
+    return (len(system.transitions), *map(id, system.modes.values()))
+
+
+def _structure(system: HybridSystem) -> str:
+    """The structural hash, computed once per system object (see the module docstring)."""
+    sid = id(system)
+    fp = _fingerprint(system)
+    hit = _STRUCT.get(sid)
+    if hit is not None and hit[0]() is system and hit[1] == fp:
+        return hit[2]
+    digest = _structure_digest(system)
+    _STRUCT[sid] = (weakref.ref(system, _forget(sid)), fp, digest)
+    return digest
+
+
+def _forget(sid: int) -> Any:
+    def drop(ref: weakref.ref) -> None:
+        hit = _STRUCT.get(sid)
+        if hit is not None and hit[0] is ref:
+            del _STRUCT[sid]
+    return drop
+
+
+def structure_key(system: HybridSystem) -> str:
+    """Cache key of a system's library: its structure, the generating sources, the toolchain."""
+    env = os.environ
+    return _key(_structure(system), env.get("CC") or "", env.get("AMBLE_CFLAGS", "-O2"), env.get("PATH") or "")
+
+
+@lru_cache(maxsize=256)
+def _key(structure: str, env_cc: str, env_flags: str, env_path: str) -> str:
+    h = hashlib.sha256(structure.encode())
+    h.update(source_digest().encode())
+    h.update(toolchain().encode())
+    return h.hexdigest()[:24]
+
+
+def library(system: HybridSystem, key: str) -> tuple[Path, dict]:
+    """Path of the system's compiled library and its loader metadata, building both if missing."""
+    d = cache_dir()
+    so, meta_f = d / f"{system.name}-{key}.so", d / f"{system.name}-{key}.json"
+    if not (so.exists() and meta_f.exists()):
+        from .codegen import generate
+
+        src, meta = generate(system)
+        _compile(src, so, d)
+        tmp = meta_f.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(meta))
+        os.replace(tmp, meta_f)
+    return so, json.loads(meta_f.read_text())
+
+
+def _compile(src: str, so: Path, d: Path) -> None:
+    cc = compiler()
+    with tempfile.TemporaryDirectory(dir=d) as tmpd:
+        c_file = Path(tmpd) / "model.c"
+        c_file.write_text(src)
+        out = Path(tmpd) / "model.so"
+        cmd = [*cc.split(), *cflags(), "-std=c99", "-Werror=implicit-function-declaration", "-fPIC", "-shared",
+               "-I", str(C_DIR), str(c_file), "-o", str(out), "-lm"]
+        try:
+            r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        except (OSError, subprocess.TimeoutExpired) as e:
+            raise CompileError(f"C compiler failed to run: {e}") from None
+        if r.returncode != 0:
+            first = next((ln for ln in r.stderr.splitlines() if "error" in ln), r.stderr.strip()[:300])
+            raise CompileError(f"C compilation of the generated model failed: {first}")
+        shutil.copy(c_file, so.with_suffix(".c"))
+        os.replace(out, so)

@@ -1,0 +1,97 @@
+"""Impulsive reset maps: the post-impact velocity of a plastic impact or a joint lock.
+
+An impulsive reset is the linear system (thesis, floating-base impact model)
+
+* ``M_e (q̇e⁺ − q̇e⁻) = Jᵀ λ``   (the impulse ``λ`` changes the momentum along the constraint),
+* ``J q̇e⁺ = 0``                (after the event the constraint holds: plastic, no sliding),
+
+solved at run time for ``(q̇e⁺, λ)`` (``amble_impulse`` in ``backend/_c/amble_core.h``). This
+module derives its symbolic ingredients:
+
+* **Impact** of a point with the ground: the model is extended by its base (stance-foot)
+  position ``b`` (``dims`` coordinates, every point shifted by ``b``), because the old stance
+  foot may lift off. With ``Jᵢ = ∂rᵢ/∂q``, ``S = Σ mᵢ Jᵢᵀ`` and total mass ``mₜ``,
+  ``M_e = [[M, S], [Sᵀ, mₜ I]]``, and the impacting point has ``J = [J_c, I]``. Before the
+  impact the base is at rest: ``q̇e⁻ = (q̇⁻, 0)``.
+* **Lock** ``c(q) = 0`` (e.g. a knee): no extension, ``M_e = M`` and ``J = ∂c/∂q``.
+
+Then the coordinates are relabelled for the target mode, ``q_new = r(q)``, and velocities follow
+by the chain rule: ``q̇_new = (∂r/∂q) q̇⁺`` — :attr:`ImpulseData.velocity_map` is ``∂r/∂q``
+(only the first ``n`` entries of ``q̇e⁺`` are used; the base velocity is dropped).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..errors import ModelError
+from ..modelling.hybrid import Impact, Lock, Reset, target_exprs
+from ..modelling.model import Model
+from .equations import Equations
+
+
+@dataclass(frozen=True)
+class ImpulseData:
+    """Symbolic impulsive reset of one transition (expressions in the source q and parameters).
+
+    ``Me``: (extended) mass matrix, ``ne × ne``; ``Jc``: constraint Jacobian, ``nc × ne``;
+    ``q_new``: target coordinates as expressions of the source coordinates; ``velocity_map``:
+    ``∂q_new/∂q``, ``nd × n``.
+    """
+
+    Me: sp.Matrix
+    Jc: sp.Matrix
+    q_new: list[sp.Expr]
+    velocity_map: sp.Matrix
+
+
+def extended_impact_data(model: Model, equations: Equations, point: str) -> tuple[sp.Matrix, sp.Matrix]:
+    """Mass matrix ``M_e`` and contact Jacobian ``J`` of the model extended with its base position
+    (see the module docstring), for a plastic impact of ``point``."""
+    if model._k_override is not None or model._l_override is not None:
+        raise ModelError(
+            f"model {model.name!r}: an Impact reset needs the kinetic energy from point masses "
+            "(K or L was given outright); give an Explicit reset instead"
+        )
+    # Added kinetic terms (rotational inertia) do not depend on the base translation, so they
+    # stay in the q-block M and contribute nothing to the base blocks.
+    n, d = len(model.q), model.dims
+    S = sp.zeros(n, d)
+    mt = sp.Integer(0)
+    for name, m in model.masses.items():
+        J = model.points[name].jacobian(model.q)
+        S += m * J.T
+        mt += m
+    Me = sp.zeros(n + d, n + d)
+    Me[:n, :n] = equations.M
+    Me[:n, n:] = S
+    Me[n:, :n] = S.T
+    Me[n:, n:] = mt * sp.eye(d)
+    Jc = sp.zeros(d, n + d)
+    Jc[:, :n] = model.points[point].jacobian(model.q)
+    Jc[:, n:] = sp.eye(d)
+    return Me, Jc
+
+
+def lock_jacobian(model: Model, constraint: sp.Expr) -> sp.Matrix:
+    """``∂c/∂q`` of a lock constraint ``c(q) = 0``, as a ``1 × n`` matrix."""
+    c = sp.sympify(constraint)
+    return sp.Matrix([[sp.diff(c, qi) for qi in model.q]])
+
+
+def impulse_data(model: Model, equations: Equations, reset: Reset, target_model: Model,
+                 what: str = "reset") -> ImpulseData:
+    """The impulsive reset of an :class:`~amble.modelling.hybrid.Impact` or
+    :class:`~amble.modelling.hybrid.Lock` from ``model`` (with its derived ``equations``) into
+    ``target_model``; ``what`` names the transition in error messages."""
+    if isinstance(reset, Impact):
+        Me, Jc = extended_impact_data(model, equations, reset.point)
+    elif isinstance(reset, Lock):
+        Me, Jc = equations.M, lock_jacobian(model, reset.constraint)
+    else:
+        raise ModelError(f"{what}: {type(reset).__name__} is not an impulsive reset (Impact or Lock)")
+    q_new = target_exprs(target_model, reset.relabel, what, source=model)
+    velocity_map = sp.Matrix(q_new).jacobian(model.q)
+    return ImpulseData(Me=Me, Jc=Jc, q_new=q_new, velocity_map=velocity_map)
