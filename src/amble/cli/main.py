@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
+from ..simulation.engine import Options
 from ..errors import AmbleError
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 
@@ -224,7 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--latex", action="store_true", help="LaTeX instead of plain text")
     e.set_defaults(func=cmd_equations)
     s = add("simulate", "simulate a model for N steps or T seconds")
-    model_args(s, 1e-10)
+    model_args(s, Options().rtol)
     g = s.add_mutually_exclusive_group()
     g.add_argument("--steps", type=int, help="number of footfalls (default 20)")
     g.add_argument("--time", type=float, help="end time in seconds")
