@@ -13,8 +13,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
-from ..simulation.engine import Options
 from ..errors import AmbleError
+from ..simulation.engine import Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 
 
