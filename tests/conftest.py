@@ -3,8 +3,10 @@ import tempfile
 
 import pytest
 
-# Compiled models go to a per-session cache so tests never depend on a stale user cache.
-os.environ.setdefault("AMBLE_CACHE_DIR", os.path.join(tempfile.gettempdir(), "amble-test-cache"))
+# Compiled models go to a cache of the tests' own (private to this user; amble refuses a cache
+# others may write to) so tests never depend on a stale user cache.
+_uid = os.getuid() if hasattr(os, "getuid") else "user"
+os.environ.setdefault("AMBLE_CACHE_DIR", os.path.join(tempfile.gettempdir(), f"amble-test-cache-{_uid}"))
 
 
 @pytest.fixture(scope="session")

@@ -17,10 +17,21 @@ objects and the number of transitions) is checked on every call, so adding a tra
 replacing a mode after a build is still caught; editing a mode's model in place after a build is
 not (build a new system instead).
 
-Builds write to a temporary file and rename it into place, so concurrent processes (Dask workers)
-can build the same model safely. The cache lives in ``$AMBLE_CACHE_DIR``, else
-``$XDG_CACHE_HOME/amble``, else ``~/.cache/amble``. ``$CC`` picks the C compiler (default
-``cc``); a C99 compiler is the one system requirement of amble.
+The cache heals and cannot be steered:
+
+* file names come from the key and the library's content hash only (``<key>-<sha>.so``; the model
+  name is metadata, never a path component);
+* ``<key>.json`` names the library and holds its SHA-256; the library is loaded only if its bytes
+  match (a truncated, planted or foreign file is never loaded — it is rebuilt);
+* every file is written to a temporary name and renamed into place, so concurrent processes (Dask
+  workers) can build the same model; build directories a killed compile left behind are removed;
+* the directory is created private (0700) and refused if another user owns it or others may
+  write to it; a cache that cannot be used (read-only, a file, no home) falls back to a private
+  temporary one for the process, with one warning.
+
+The cache lives in ``$AMBLE_CACHE_DIR``, else ``$XDG_CACHE_HOME/amble``, else
+``~/.cache/amble``. ``$CC`` picks the C compiler (default ``cc``); a C99 compiler is the one
+system requirement of amble.
 """
 
 from __future__ import annotations
@@ -31,6 +42,8 @@ import os
 import shutil
 import subprocess
 import tempfile
+import time
+import warnings
 import weakref
 from functools import lru_cache
 from importlib import resources
@@ -54,16 +67,57 @@ _SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/model.py", "model
 _STRUCT: dict[int, tuple[weakref.ref, tuple, str]] = {}
 
 
-def cache_dir() -> Path:
-    """The cache directory (created if missing)."""
+#: build directories older than this (s) belong to a compile that was killed
+_ORPHAN_AGE = 3600.0
+_FALLBACK: dict[str, Path] = {}
+
+
+class CacheWarning(UserWarning):
+    """The configured cache directory cannot be used; a private temporary one is used instead."""
+
+
+def _configured_dir() -> Path:
     env = os.environ.get("AMBLE_CACHE_DIR")
     if env:
-        d = Path(env)
-    else:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        d = Path(xdg) / "amble" if xdg else Path.home() / ".cache" / "amble"
-    d.mkdir(parents=True, exist_ok=True)
-    return d
+        return Path(env)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return Path(xdg) / "amble" if xdg else Path.home() / ".cache" / "amble"
+
+
+def _unusable(d: Path) -> str | None:
+    """Why ``d`` cannot serve as a cache (after trying to create it private), or ``None``."""
+    try:
+        d.mkdir(mode=0o700, parents=True, exist_ok=True)
+    except OSError as e:
+        return f"cannot create it ({e.strerror or e})"
+    if not d.is_dir():
+        return "it is not a directory"
+    st = d.stat()
+    if hasattr(os, "getuid") and st.st_uid != os.getuid():
+        return "another user owns it"
+    if st.st_mode & 0o022:
+        return "other users may write to it"
+    if not os.access(d, os.W_OK | os.X_OK):
+        return "it is not writable"
+    return None
+
+
+def cache_dir() -> Path:
+    """The cache directory: the configured one if it is usable (see the module docstring), else a
+    private temporary directory for this process (with a :class:`CacheWarning`)."""
+    try:
+        d = _configured_dir()
+        why = _unusable(d)
+    except RuntimeError as e:  # Path.home() without a home
+        d, why = Path("~"), f"no home directory ({e})"
+    if why is None:
+        return d
+    key = str(d)
+    if key not in _FALLBACK:
+        _FALLBACK[key] = Path(tempfile.mkdtemp(prefix="amble-cache-"))
+        warnings.warn(f"amble: cache {d} is not usable ({why}); compiling into {_FALLBACK[key]} for this process",
+                      CacheWarning, stacklevel=2)
+    return _FALLBACK[key]
 
 
 def source_files() -> list[Path]:
@@ -186,23 +240,66 @@ def _key(structure: str, env_cc: str, env_flags: str, env_path: str) -> str:
 
 
 def library(system: HybridSystem, key: str) -> tuple[Path, dict]:
-    """Path of the system's compiled library and its loader metadata, building both if missing."""
+    """Path of the system's compiled library and its loader metadata: the cached ones if they are
+    intact (:func:`cached`), else built now."""
     d = cache_dir()
-    so, meta_f = d / f"{system.name}-{key}.so", d / f"{system.name}-{key}.json"
-    if not (so.exists() and meta_f.exists()):
-        from .codegen import generate
-
-        src, meta = generate(system)
-        _compile(src, so, d)
-        tmp = meta_f.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(meta))
-        os.replace(tmp, meta_f)
-    return so, json.loads(meta_f.read_text())
+    hit = cached(d, key)
+    if hit is not None:
+        return hit
+    return rebuild(system, key, d)
 
 
-def _compile(src: str, so: Path, d: Path) -> None:
+def cached(d: Path, key: str) -> tuple[Path, dict] | None:
+    """The cached library of ``key`` if its metadata parses and the library's bytes have the
+    recorded SHA-256, else ``None``."""
+    try:
+        meta = json.loads((d / f"{key}.json").read_text())
+        so = d / meta["library"]
+        ok = so.parent == d and _sha256(so) == meta["library_sha256"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return (so, meta) if ok else None
+
+
+def rebuild(system: HybridSystem, key: str, d: Path | None = None) -> tuple[Path, dict]:
+    """Generate, compile and record the library of ``system`` under ``key`` (replacing any entry)."""
+    from .codegen import generate
+
+    d = d or cache_dir()
+    _remove_orphans(d)
+    src, meta = generate(system)
+    so, digest = _compile(src, key, d)
+    meta = {**meta, "library": so.name, "library_sha256": digest}
+    _write_atomic(d / f"{key}.json", json.dumps(meta).encode())
+    _write_atomic(so.with_suffix(".c"), src.encode())  # the generated source, for inspection
+    return so, meta
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
+
+
+def _remove_orphans(d: Path) -> None:
+    """Remove build directories and temporary files that a killed process left behind."""
+    now = time.time()
+    for p in list(d.glob("build-*")) + list(d.glob(".*.tmp")):
+        try:
+            if now - p.stat().st_mtime > _ORPHAN_AGE:
+                shutil.rmtree(p) if p.is_dir() else p.unlink()
+        except OSError:
+            pass
+
+
+def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
+    """Compile ``src`` into ``d/<key>-<sha>.so``; returns the path and the library's SHA-256."""
     cc = compiler()
-    with tempfile.TemporaryDirectory(dir=d) as tmpd:
+    with tempfile.TemporaryDirectory(prefix="build-", dir=d) as tmpd:
         c_file = Path(tmpd) / "model.c"
         c_file.write_text(src)
         out = Path(tmpd) / "model.so"
@@ -211,9 +308,15 @@ def _compile(src: str, so: Path, d: Path) -> None:
         try:
             r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         except (OSError, subprocess.TimeoutExpired) as e:
-            raise CompileError(f"C compiler failed to run: {e}") from None
+            raise CompileError(f"C compiler {cc!r} failed to run: {e}") from None
         if r.returncode != 0:
-            first = next((ln for ln in r.stderr.splitlines() if "error" in ln), r.stderr.strip()[:300])
-            raise CompileError(f"C compilation of the generated model failed: {first}")
-        shutil.copy(c_file, so.with_suffix(".c"))
+            lines = [ln.strip() for ln in r.stderr.splitlines() if ln.strip()]
+            errors = [ln for ln in lines if "error" in ln.lower()] or lines
+            said = "; ".join(errors[:3])[:500] if errors else "no output"
+            raise CompileError(f"C compilation of the generated model failed ({cc!r}, exit {r.returncode}): {said}")
+        if not out.is_file() or out.stat().st_size == 0:
+            raise CompileError(f"C compiler {cc!r} reported success but wrote no library")
+        digest = _sha256(out)
+        so = d / f"{key}-{digest[:16]}.so"
         os.replace(out, so)
+    return so, digest

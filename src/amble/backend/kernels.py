@@ -36,7 +36,12 @@ def build(system: HybridSystem) -> Kernels:
     k = _LOADED.get(key)
     if k is None:
         so, meta = cache.library(system, key)
-        k = _LOADED[key] = Kernels(so, meta)
+        try:
+            k = Kernels(so, meta)
+        except CompileError:  # intact bytes that do not load (another layout, a foreign build): rebuild once
+            so, meta = cache.rebuild(system, key)
+            k = Kernels(so, meta)
+        _LOADED[key] = k
     return _with_defaults(k, system)
 
 
