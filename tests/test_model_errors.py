@@ -85,3 +85,17 @@ def test_impact_needs_point_masses():
     s.transition("hit", "k-outright", Guard(q), Impact("tip", {}))
     with pytest.raises(ModelError, match="point masses"):
         simulate(s, [0.5, 0.0], t_end=1.0)
+
+
+@pytest.mark.parametrize("declare, message", [
+    (lambda m: m.parameter("t", 3.0), "reserved for time"),
+    (lambda m: m.coordinates("x x_dot"), "already taken"),        # x_dot is x's velocity
+    (lambda m: (m.coordinates("x"), m.parameter("x_dot", 1.0)), "already taken"),
+    (lambda m: (m.parameter("k", 1.0), m.coordinates("k")), "already taken"),
+    (lambda m: m.coordinates(["x y"]), "not an identifier"),
+])
+def test_a_name_stands_for_one_symbol(declare, message):
+    # each of these once gave silently wrong physics (a parameter t replaced the time symbol;
+    # a coordinate x_dot shared its symbol with x's velocity)
+    with pytest.raises(ModelError, match=message):
+        declare(Model("names"))

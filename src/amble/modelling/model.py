@@ -76,8 +76,8 @@ class Model:
             names = names.replace(",", " ").split()
         out = []
         for n in names:
-            if any(str(s) == n for s in self.q) or any(str(s) == n for s in self.params):
-                raise ModelError(f"model {self.name!r}: name {n!r} declared twice")
+            self._check_new_name(n, "coordinate")
+            self._check_new_name(f"{n}_dot", f"velocity of coordinate {n!r}")
             s = sp.Symbol(n, real=True)
             self.q.append(s)
             self.qd.append(sp.Symbol(f"{n}_dot", real=True))
@@ -91,8 +91,7 @@ class Model:
 
     def parameter(self, name: str, default: float, doc: str = "", unit: str = "") -> sp.Symbol:
         """Declare one parameter with its default value, an optional one-line description and unit."""
-        if any(str(s) == name for s in self.q) or any(str(s) == name for s in self.params):
-            raise ModelError(f"model {self.name!r}: name {name!r} declared twice")
+        self._check_new_name(name, "parameter")
         try:
             value = float(default)
         except (TypeError, ValueError):
@@ -106,6 +105,17 @@ class Model:
         if unit:
             self.units[name] = unit
         return s
+
+    def _check_new_name(self, name: str, what: str) -> None:
+        """Every name of a model stands for one symbol: refuse one already taken — by a coordinate,
+        a velocity (``<coordinate>_dot``), a parameter, or the time ``t``."""
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ModelError(f"model {self.name!r}: {what} name {name!r} is not an identifier")
+        if name == str(t):
+            raise ModelError(f"model {self.name!r}: {what} name 't' is reserved for time")
+        for s in (*self.q, *self.qd, *self.params):
+            if str(s) == name:
+                raise ModelError(f"model {self.name!r}: {what} name {name!r} is already taken")
 
     def declare_units(self, **units: str) -> None:
         """Units of declared coordinates or parameters by name, e.g. ``declare_units(mh="kg", a="m")``."""
