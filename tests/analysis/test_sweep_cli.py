@@ -138,3 +138,17 @@ def test_records_and_table_give_numbers(compass):
                          reused=0, types={"period": "int", "d": "float"})
     assert failed.records()[0]["period"] is None and math.isnan(failed.records()[0]["d"])
     assert failed.table()["period"] == [None]
+
+
+def test_a_result_file_in_use_by_another_sweep_is_refused(tmp_path):
+    # two sweeps on one file once both "completed", and the file held only one of them
+    from amble.analysis.store import ResultStore
+    from amble.errors import OutputError
+
+    out = tmp_path / "sweep.csv"
+    with ResultStore(out, ["i", "v"], ["i"]) as first:
+        first.append([{"i": 0, "v": 1.0}])
+        with pytest.raises(OutputError, match="in use by another sweep"):
+            ResultStore(out, ["i", "v"], ["i"])
+    with ResultStore(out, ["i", "v"], ["i"]) as again:  # released at the end of the first
+        assert again.has(("0",))

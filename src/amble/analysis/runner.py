@@ -57,8 +57,10 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
 
     if isinstance(scheduler, Client):
         return scheduler, lambda: None
+    if scheduler is not None and not str(scheduler).strip():
+        raise SchedulerError("empty scheduler address: give tcp://host:port, 'synchronous', or omit the option")
     if scheduler:
-        _refuse_fast(str(scheduler))
+        _check_scheduler(str(scheduler))
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as e:
@@ -77,25 +79,53 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
     return client, close
 
 
-def _refuse_fast(address: str) -> None:
-    """Raise :class:`SchedulerError` at once when nothing listens at a ``tcp://host:port`` address
-    (the Dask client would retry a refused connection until its timeout)."""
+#: Seconds a scheduler address gets to accept a connection and to greet it.
+HANDSHAKE_TIMEOUT = 5.0
+
+
+def _check_scheduler(address: str) -> None:
+    """Raise :class:`SchedulerError` within a few seconds unless a Dask scheduler answers at a
+    ``tcp://host:port`` (or ``host:port``) address.
+
+    A Dask scheduler writes its handshake as soon as a connection is accepted, framed as 8-byte
+    little-endian counts (total bytes, number of frames, frame lengths). Anything else — nothing
+    listening, a server that stays silent (an HTTP server waits for a request), a server that
+    greets in another protocol — is refused here: the Dask client would wait on it without end or
+    read its bytes as a frame length."""
     import socket
+    import struct
     from urllib.parse import urlsplit
 
+    text = address if "://" in address else f"tcp://{address}"
     try:
-        u = urlsplit(address)
-        host, port = u.hostname, u.port
-    except ValueError:
-        return
-    if u.scheme != "tcp" or not host or not port:
-        return
+        u = urlsplit(text)
+        host, port, scheme = u.hostname, u.port, u.scheme
+    except ValueError as e:
+        raise SchedulerError(f"scheduler address {address!r} is malformed ({e})") from None
+    if scheme != "tcp":
+        return  # tls://, inproc://, ws://: left to the Dask client and its timeout
+    if not host or not port:
+        raise SchedulerError(f"scheduler address {address!r} needs a host and a port (tcp://host:port)")
     try:
-        socket.create_connection((host, port), timeout=2).close()
-    except ConnectionRefusedError as e:
-        raise SchedulerError(f"cannot connect to the Dask scheduler at {address!r} ({e.strerror})") from None
-    except OSError:
-        pass  # unreachable or slow: let the client try, with its own timeout
+        sock = socket.create_connection((host, port), timeout=HANDSHAKE_TIMEOUT)
+    except OSError as e:
+        raise SchedulerError(f"cannot connect to the Dask scheduler at {address!r} ({e.strerror or e})") from None
+    with sock:
+        sock.settimeout(HANDSHAKE_TIMEOUT)
+        data = b""
+        try:
+            while len(data) < 16:
+                chunk = sock.recv(16 - len(data))
+                if not chunk:
+                    break
+                data += chunk
+        except OSError:  # timeout included
+            pass
+    if len(data) < 16:
+        raise SchedulerError(f"{address!r} is not a Dask scheduler: no handshake within {HANDSHAKE_TIMEOUT:g} s")
+    total, nframes = struct.unpack("<QQ", data)
+    if not (1 <= nframes <= 64 and 16 < total < 1 << 20) and not (1 <= total <= 64):
+        raise SchedulerError(f"{address!r} answered, but not as a Dask scheduler")
 
 
 def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, progress: bool, total: int,

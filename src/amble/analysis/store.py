@@ -43,6 +43,11 @@ class ResultStore:
     ``path``: ``FILE.csv``, ``FILE.parquet`` or ``None`` (rows kept in memory only); existing
     rows are loaded on construction. ``columns``: every column, in file order; ``key``: the
     columns that identify a point (first row of a key wins).
+
+    A store with a file holds an exclusive advisory lock on ``.FILE.lock`` from construction to
+    :meth:`close` (it is a context manager): a second sweep on the same file is refused with an
+    :class:`OutputError` instead of both writing it (the compaction of one would drop the rows
+    of the other).
     """
 
     def __init__(self, path: str | os.PathLike | None, columns: Sequence[str], key: Sequence[str]) -> None:
@@ -54,7 +59,24 @@ class ResultStore:
         self.parquet = self.final is not None and self.final.suffix.lower() == ".parquet"
         self.journal = (self.final.with_name(self.final.name + ".journal.csv") if self.parquet else self.final)
         self.rows: dict[tuple[str, ...], dict[str, str]] = {}
-        self._load()
+        self._lock = _lock(self.final) if self.final is not None else None
+        try:
+            self._load()
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Release the file's lock (rows already appended are durable)."""
+        if self._lock is not None:
+            self._lock.close()  # closing the descriptor releases the flock
+            self._lock = None
+
+    def __enter__(self) -> ResultStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def _load(self) -> None:
         if self.final is None:
@@ -152,6 +174,33 @@ class ResultStore:
         os.replace(tmp, self.final)
         if self.parquet and self.journal is not None and self.journal.exists():
             self.journal.unlink()
+
+
+def _lock(final: Path) -> Any:
+    """An open lock file beside ``final``, exclusively locked; :class:`OutputError` if another
+    process holds it. Where ``fcntl`` is missing (Windows) sweeps are not locked."""
+    try:
+        import fcntl
+    except ImportError:
+        return None
+    path = final.with_name(f".{final.name}.lock")
+    try:
+        f = open(path, "a+")
+    except OSError as e:
+        raise OutputError(f"cannot lock result file {str(final)!r} ({e.strerror or e})") from None
+    try:
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        f.seek(0)
+        holder = f.read().strip()
+        f.close()
+        raise OutputError(f"result file {str(final)!r} is in use by another sweep"
+                          f"{f' (process {holder})' if holder else ''}; wait for it or use another file") from None
+    f.seek(0)
+    f.truncate()
+    f.write(str(os.getpid()))
+    f.flush()
+    return f
 
 
 def fmt_value(v: Any) -> str:

@@ -71,37 +71,37 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
     task ``make_task(points, group, store)``, run as ``fn(*task)``. ``computed`` / ``reused``
     of the result count keys.
     """
-    store = ResultStore(out, list(columns), key)
-    flat = [kk for ks in keys for kk in ks]
-    store.check_keys(flat)
-    per = max(1, max((len(ks) for ks in keys), default=1))  # keys per point (a basin row: its cells)
-    missing = sum(1 for kk in flat if not store.has(kk))
-    pending_points = sum(1 for ks in keys if not all(store.has(kk) for kk in ks))
-    budget = pending_points if max_points is None else max(0, min(pending_points, int(max_points) // per))
-    tasks, n_sched = [], 0
-    for grp in groups:
-        pts = [g for g in grp if not all(store.has(kk) for kk in keys[g])]
-        step = split or max(1, len(pts))
-        for run in (pts[i:i + step] for i in range(0, len(pts), step)):
-            if n_sched >= budget:
-                break
-            run = run[: budget - n_sched]
-            tasks.append(make_task(run, grp, store))
-            n_sched += len(run)
-    computed = n_sched * per
-    client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
-    try:
-        execute(client, fn, tasks, store, progress, computed, kind)
-    finally:
-        close()
-    complete = all(store.has(kk) for kk in flat)
-    if complete:
-        store.compact()
-    wanted = set(flat)
-    rows = [r for r in store.sorted_rows() if tuple(r[c] for c in key) in wanted]
-    return SweepResult(kind=kind, params=list(params), rows=rows, path=str(out) if out else None, complete=complete,
-                       computed=computed, reused=len(flat) - missing, state_names=list(state_names),
-                       types=dict(columns))
+    with ResultStore(out, list(columns), key) as store:  # holds the file's lock until the end
+        flat = [kk for ks in keys for kk in ks]
+        store.check_keys(flat)
+        per = max(1, max((len(ks) for ks in keys), default=1))  # keys per point (a basin row: its cells)
+        missing = sum(1 for kk in flat if not store.has(kk))
+        pending_points = sum(1 for ks in keys if not all(store.has(kk) for kk in ks))
+        budget = pending_points if max_points is None else max(0, min(pending_points, int(max_points) // per))
+        tasks, n_sched = [], 0
+        for grp in groups:
+            pts = [g for g in grp if not all(store.has(kk) for kk in keys[g])]
+            step = split or max(1, len(pts))
+            for run in (pts[i:i + step] for i in range(0, len(pts), step)):
+                if n_sched >= budget:
+                    break
+                run = run[: budget - n_sched]
+                tasks.append(make_task(run, grp, store))
+                n_sched += len(run)
+        computed = n_sched * per
+        client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
+        try:
+            execute(client, fn, tasks, store, progress, computed, kind)
+        finally:
+            close()
+        complete = all(store.has(kk) for kk in flat)
+        if complete:
+            store.compact()
+        wanted = set(flat)
+        rows = [r for r in store.sorted_rows() if tuple(r[c] for c in key) in wanted]
+        return SweepResult(kind=kind, params=list(params), rows=rows, path=str(out) if out else None, complete=complete,
+                           computed=computed, reused=len(flat) - missing, state_names=list(state_names),
+                           types=dict(columns))
 
 
 __all__ = ["compiled", "point_key", "run_sweep", "seed_before"]
