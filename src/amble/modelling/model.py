@@ -23,9 +23,42 @@ from collections.abc import Sequence
 from typing import Any
 
 import sympy as sp
+from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
-from .geometry import t, vector
+from .geometry import t
+
+
+def _expr(model: str, value: Any, what: str) -> sp.Expr:
+    """``value`` as a sympy expression fit for compiled code, or a :class:`ModelError` naming
+    ``what``: no unparsable text, no undefined functions, no infinite, undefined or complex
+    constants (code generation would fail on them far from where they were written)."""
+    try:
+        e = sp.sympify(value)
+    except (sp.SympifyError, TypeError, SyntaxError) as exc:
+        raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
+    if not isinstance(e, sp.Expr):
+        raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
+    undefined = sorted(str(f.func) for f in e.atoms(AppliedUndef))
+    if undefined:
+        raise ModelError(f"model {model!r}: {what} uses undefined function(s) {', '.join(undefined)}")
+    if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
+        raise ModelError(f"model {model!r}: {what} contains an infinite, undefined or complex value: {e}")
+    return e
+
+
+def _matrix(model: str, value: Any, what: str) -> sp.Matrix:
+    """A column (from a flat sequence) or a matrix (from rows, or a sympy matrix) of :func:`_expr`
+    entries."""
+    if isinstance(value, sp.MatrixBase):
+        rows = value.tolist()
+    elif isinstance(value, (list, tuple)):
+        rows = [list(r) if isinstance(r, (list, tuple)) else [r] for r in value]
+    else:
+        raise ModelError(f"model {model!r}: {what} must be a vector or matrix, got {value!r}")
+    if len({len(r) for r in rows}) > 1:
+        raise ModelError(f"model {model!r}: {what} has rows of different lengths")
+    return sp.Matrix([[_expr(model, e, what) for e in r] for r in rows])
 
 
 class Model:
@@ -161,8 +194,7 @@ class Model:
 
         Returns the position as a column vector so that later points can be built from it.
         """
-        pos = position if isinstance(position, sp.MatrixBase) else vector(*position)
-        pos = sp.Matrix(pos)
+        pos = _matrix(self.name, position, f"position of point {name!r}")
         if pos.shape != (self.dims, 1):
             raise ModelError(
                 f"model {self.name!r}: point {name!r} has {len(pos)} components, "
@@ -182,7 +214,7 @@ class Model:
         """Put a point mass ``m`` (kg) at the named point."""
         if point not in self.points:
             raise ModelError(f"model {self.name!r}: mass placed at unknown point {point!r}")
-        m = sp.sympify(m)
+        m = _expr(self.name, m, f"mass at {point!r}")
         self._check_symbols(m, f"mass at {point!r}")
         self.masses[point] = self.masses.get(point, sp.Integer(0)) + m
 
@@ -195,7 +227,8 @@ class Model:
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
-        self._k_terms.append(sp.Rational(1, 2) * sp.sympify(moment) * self.dt(angle) ** 2)
+        moment = _expr(self.name, moment, "moment of inertia")
+        self._k_terms.append(sp.Rational(1, 2) * moment * self.dt(_expr(self.name, angle, "inertia angle")) ** 2)
 
     def body_inertia(self, rotation: Any, inertia: Any) -> None:
         """Rotational inertia of a 3D body with orientation ``rotation`` (3×3, body → world).
@@ -204,8 +237,8 @@ class Model:
         inertia tensor ``I`` (kg·m², body axes, about the body's centre of mass — whose mass is
         declared with :meth:`point`).
         """
-        Rm = sp.Matrix(rotation)
-        Im = sp.Matrix(inertia)
+        Rm = _matrix(self.name, rotation, "body rotation")
+        Im = _matrix(self.name, inertia, "body inertia")
         if Rm.shape != (3, 3) or Im.shape != (3, 3):
             raise ModelError(f"model {self.name!r}: body_inertia needs a 3×3 rotation and a 3×3 inertia")
         W = Rm.T * self.dt(Rm)
@@ -215,9 +248,9 @@ class Model:
     # ------------------------------------------------------------------ energies
     def gravity(self, g: Any, direction: Any = None) -> None:
         """Uniform gravity of magnitude ``g`` (m/s²) along ``direction`` (default: down, -z)."""
-        self._g = sp.sympify(g)
+        self._g = _expr(self.name, g, "gravity")
         if direction is not None:
-            d = sp.Matrix(direction)
+            d = _matrix(self.name, direction, "gravity direction")
             if d.shape != (self.dims, 1):
                 raise ModelError(f"model {self.name!r}: gravity direction needs {self.dims} components")
             self._g_dir = d
@@ -225,11 +258,11 @@ class Model:
 
     def add_kinetic(self, expr: Any) -> None:
         """Add a kinetic-energy term (J) in q and the velocity symbols."""
-        self._k_terms.append(sp.sympify(expr))
+        self._k_terms.append(_expr(self.name, expr, "kinetic energy term"))
 
     def add_potential(self, expr: Any) -> None:
         """Add a potential-energy term (J) in q, e.g. a spring ``k*(q1 - q2)**2/2``."""
-        self._v_terms.append(sp.sympify(expr))
+        self._v_terms.append(_expr(self.name, expr, "potential energy term"))
 
     @property
     def K(self) -> sp.Expr:
@@ -244,7 +277,7 @@ class Model:
 
     @K.setter
     def K(self, expr: Any) -> None:
-        self._k_override = sp.sympify(expr)
+        self._k_override = _expr(self.name, expr, "K")
 
     @property
     def V(self) -> sp.Expr:
@@ -259,7 +292,7 @@ class Model:
 
     @V.setter
     def V(self, expr: Any) -> None:
-        self._v_override = sp.sympify(expr)
+        self._v_override = _expr(self.name, expr, "V")
 
     @property
     def L(self) -> sp.Expr:
@@ -270,7 +303,7 @@ class Model:
 
     @L.setter
     def L(self, expr: Any) -> None:
-        self._l_override = sp.sympify(expr)
+        self._l_override = _expr(self.name, expr, "L")
 
     @property
     def gravity_vector(self) -> sp.Matrix:
@@ -280,7 +313,7 @@ class Model:
     # ------------------------------------------------------------------ forces
     def force(self, generalized: Any) -> None:
         """Add a generalized force vector Γ (one entry per coordinate; may depend on q, q̇, t)."""
-        v = sp.Matrix(generalized)
+        v = _matrix(self.name, generalized, "generalized force")
         if v.shape != (len(self.q), 1):
             raise ModelError(
                 f"model {self.name!r}: generalized force needs {len(self.q)} entries, got {len(v)}"
@@ -293,14 +326,15 @@ class Model:
         By virtual work its generalized force is ``tau · ∂angle/∂q``: a hip torque between two
         absolute leg angles is ``model.torque(tau, swing - stance)``.
         """
-        angle = sp.sympify(angle)
-        self._forces.append(sp.Matrix([sp.sympify(tau) * sp.diff(angle, qi) for qi in self.q]))
+        angle = _expr(self.name, angle, "torque angle")
+        tau = _expr(self.name, tau, "torque")
+        self._forces.append(sp.Matrix([tau * sp.diff(angle, qi) for qi in self.q]))
 
     def point_force(self, point: str, force: Any) -> None:
         """A force (N, world frame) applied at a named point; Γ = Jᵀ F."""
         if point not in self.points:
             raise ModelError(f"model {self.name!r}: force on unknown point {point!r}")
-        f = sp.Matrix(force)
+        f = _matrix(self.name, force, f"force on point {point!r}")
         jac = self.points[point].jacobian(self.q)
         self._forces.append(jac.T * f)
 
