@@ -35,7 +35,7 @@ def _expr(model: str, value: Any, what: str) -> sp.Expr:
     constants (code generation would fail on them far from where they were written)."""
     try:
         e = sp.sympify(value)
-    except (sp.SympifyError, TypeError, SyntaxError) as exc:
+    except (sp.SympifyError, TypeError, SyntaxError):
         raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
     if not isinstance(e, sp.Expr):
         raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
