@@ -16,6 +16,7 @@ from .errors import (
     SimulationError,
     StateError,
 )
+from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval
 from .modelling.geometry import R3, R, t, vector
 from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
 from .modelling.model import Model
@@ -27,9 +28,9 @@ from .version import __version__  # noqa: F401  (amble.__version__)
 from .viz import animate, plot_limit_cycle, plot_trajectory
 
 __all__ = [
-    "AmbleError", "CompileError", "ConvergenceError", "Equations", "Event", "Explicit", "Guard",
-    "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError", "ParameterError", "R", "R3",
-    "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate", "derive",
-    "distance_along_slope", "heel_strike", "height_above_slope", "joint_lock", "plot_limit_cycle",
-    "plot_trajectory", "simulate", "t", "vector", "walker",
+    "NONNEGATIVE", "POSITIVE", "R", "R3", "AmbleError", "CompileError", "ConvergenceError", "Domain", "Equations",
+    "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
+    "ParameterError", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
+    "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
+    "plot_limit_cycle", "plot_trajectory", "simulate", "t", "vector", "walker",
 ]

@@ -76,7 +76,7 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
     out = []
     for i, val in points:
         params = {**base, param: val}
-        p = parameter_vector(k, params)
+        p = parameter_vector(k, params, system)
         if x is not None:  # the carried state must sit on the section of the new parameters
             x = on_section(snames, dict(zip(k.meta["params"], p.tolist())), x)
         row: dict[str, Any] = {"i": i, param: val, "coordinate": snames[coord]}
@@ -145,7 +145,7 @@ def bifurcation(
     iterates repeating within ``period_tol`` (0 = no period found: chaos or slow transient).
     A value where the walker falls is recorded ``failed`` with the reason.
     """
-    v = sweep_values(values, param)
+    v = sweep_values(values, param, system)
     _, _, snames = compiled(system, params, [param])
     if isinstance(coordinate, str):
         if coordinate not in snames:
@@ -186,7 +186,7 @@ def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *
     """Successive post-impact states (steps+1 × n; row 0 = x0 or the model's guess); rows after
     a fall are absent (the array is shorter)."""
     k = build(system)
-    p = parameter_vector(k, params)
+    p = parameter_vector(k, params, system)
     mode = k.meta["modes"][0]
     mi = k.mode_index(mode)
     x = np.asarray(x0 if x0 is not None else (system.fixed_point_guess or system.default_start[mode]), float)

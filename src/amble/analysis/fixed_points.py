@@ -113,7 +113,7 @@ def sweep_fixed_points(
     ``out``: result file (.csv/.parquet), resumed if it exists. ``max_points``: compute at most
     this many missing points in this call (a deliberately partial run).
     """
-    v = sweep_values(values, param)
+    v = sweep_values(values, param, system)
     if chunk < 1:
         raise StateError(f"chunk must be at least 1, got {chunk}")
     grid = [(i, 0, (float(x),)) for i, x in enumerate(v)]
@@ -147,7 +147,7 @@ def sweep_fixed_points_2d(
     a, b = params2
     if a == b:
         raise StateError(f"the two swept parameters must differ, got {a!r} twice")
-    va, vb = sweep_values(values[0], a), sweep_values(values[1], b)
+    va, vb = sweep_values(values[0], a, system), sweep_values(values[1], b, system)
     grid = [(i, j, (float(x), float(y))) for i, x in enumerate(va) for j, y in enumerate(vb)]
     groups = [list(range(i * len(vb), (i + 1) * len(vb))) for i in range(len(va))]
     return _fp_sweep(system, [a, b], grid, groups, params=params, continuation=continuation, out=out,

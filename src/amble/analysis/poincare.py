@@ -89,7 +89,7 @@ class ReturnMap:
             raise StateError(f"period must be at least 1, got {period}")
         self.system = system
         self.k: Kernels = build(system)
-        self.p = parameter_vector(self.k, params)
+        self.p = parameter_vector(self.k, params, system)
         self.period = period
         self.mode = mode or self.k.meta["modes"][0]
         self.mi = self.k.mode_index(self.mode)

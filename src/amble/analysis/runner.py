@@ -167,13 +167,17 @@ def check_params(system: HybridSystem, names: Sequence[str]) -> None:
             raise ParameterError(f"unknown parameter {n!r}; known: {', '.join(known)}")
 
 
-def sweep_values(values: Sequence[float], what: str) -> np.ndarray:
-    """``values`` as a flat float array; refuses an empty or non-finite list (``what`` names it)."""
+def sweep_values(values: Sequence[float], what: str, system: HybridSystem | None = None) -> np.ndarray:
+    """``values`` as a flat float array; refuses an empty or non-finite list (``what`` names it)
+    and, given the ``system``, values of parameter ``what`` outside its declared domain."""
     v = np.asarray(values, dtype=float).ravel()
     if v.size == 0:
         raise StateError(f"{what}: no values to sweep")
     if not np.all(np.isfinite(v)):
         raise StateError(f"{what}: values must be finite")
+    if system is not None:
+        for x in (v.min(), v.max()):  # a domain is an interval: its ends decide
+            system.check_parameters({what: float(x)})
     return v
 
 

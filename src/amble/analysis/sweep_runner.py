@@ -32,7 +32,7 @@ def compiled(system: HybridSystem, params: Mapping[str, float] | None,
     parameter vector of ``params`` and the state names of the first mode; ``swept`` must be
     parameters of ``system``."""
     k = build(system)
-    pvec = parameter_vector(k, params)
+    pvec = parameter_vector(k, params, system)
     check_params(system, swept)
     return k, pvec, list(k.meta["state_names"][k.meta["modes"][0]])
 

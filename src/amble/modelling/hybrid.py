@@ -26,7 +26,7 @@ from typing import Any
 
 import sympy as sp
 
-from ..errors import ModelError
+from ..errors import ModelError, ParameterError
 from .model import Model
 
 
@@ -213,6 +213,15 @@ class HybridSystem:
                     )
                 out[k] = v
         return out
+
+    def check_parameters(self, values: Mapping[str, float]) -> None:
+        """Raise :class:`ParameterError` for a value outside its parameter's declared domain."""
+        for name, v in values.items():
+            for m in self.modes.values():
+                dom = m.domains.get(name)
+                if dom is not None and v not in dom:
+                    unit = f" {m.unit(name)}" if m.unit(name) else ""
+                    raise ParameterError(f"parameter {name!r} = {v:g}{unit} is outside its domain {dom}")
 
     @property
     def time_unit(self) -> str:

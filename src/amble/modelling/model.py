@@ -19,49 +19,18 @@ convention of the thesis and of Drake (from the vertical, positive in the walkin
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import Any
 
 import sympy as sp
-from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
+from .expressions import checked_expr as _expr
+from .expressions import checked_matrix as _matrix
 from .geometry import t
+from .names import Names
 
 
-def _expr(model: str, value: Any, what: str) -> sp.Expr:
-    """``value`` as a sympy expression fit for compiled code, or a :class:`ModelError` naming
-    ``what``: no unparsable text, no undefined functions, no infinite, undefined or complex
-    constants (code generation would fail on them far from where they were written)."""
-    try:
-        e = sp.sympify(value)
-    except (sp.SympifyError, TypeError, SyntaxError):
-        raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
-    if not isinstance(e, sp.Expr):
-        raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
-    undefined = sorted(str(f.func) for f in e.atoms(AppliedUndef))
-    if undefined:
-        raise ModelError(f"model {model!r}: {what} uses undefined function(s) {', '.join(undefined)}")
-    if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
-        raise ModelError(f"model {model!r}: {what} contains an infinite, undefined or complex value: {e}")
-    return e
-
-
-def _matrix(model: str, value: Any, what: str) -> sp.Matrix:
-    """A column (from a flat sequence) or a matrix (from rows, or a sympy matrix) of :func:`_expr`
-    entries."""
-    if isinstance(value, sp.MatrixBase):
-        rows = value.tolist()
-    elif isinstance(value, (list, tuple)):
-        rows = [list(r) if isinstance(r, (list, tuple)) else [r] for r in value]
-    else:
-        raise ModelError(f"model {model!r}: {what} must be a vector or matrix, got {value!r}")
-    if len({len(r) for r in rows}) > 1:
-        raise ModelError(f"model {model!r}: {what} has rows of different lengths")
-    return sp.Matrix([[_expr(model, e, what) for e in r] for r in rows])
-
-
-class Model:
+class Model(Names):
     """A mechanical system in one mode, written as positions, masses and energies.
 
     Parameters
@@ -78,16 +47,8 @@ class Model:
     def __init__(self, name: str, dims: int = 2, time_unit: str = "s") -> None:
         if dims not in (2, 3):
             raise ModelError(f"model {name!r}: dims must be 2 or 3, got {dims!r}")
-        self.name = name
+        super().__init__(name, time_unit)
         self.dims = dims
-        self.q: list[sp.Symbol] = []
-        self.qd: list[sp.Symbol] = []
-        self.params: dict[sp.Symbol, float] = {}
-        self.time_unit = time_unit
-        #: unit of each coordinate and parameter by name (plots, tables and file headers read it)
-        self.units: dict[str, str] = {}
-        #: one-line description of a parameter by name
-        self.descriptions: dict[str, str] = {}
         self.points: dict[str, sp.Matrix] = {}
         self.masses: dict[str, sp.Expr] = {}
         self.links: list[tuple[str, str]] = []
@@ -100,80 +61,6 @@ class Model:
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
-
-    # ------------------------------------------------------------------ symbols
-    def coordinates(self, names: str | Sequence[str], unit: str = "rad") -> tuple[sp.Symbol, ...]:
-        """Declare generalized coordinates (in ``unit``, default radians); returns their symbols
-        (velocities: :meth:`dot`)."""
-        if isinstance(names, str):
-            names = names.replace(",", " ").split()
-        out = []
-        for n in names:
-            self._check_new_name(n, "coordinate")
-            self._check_new_name(f"{n}_dot", f"velocity of coordinate {n!r}")
-            s = sp.Symbol(n, real=True)
-            self.q.append(s)
-            self.qd.append(sp.Symbol(f"{n}_dot", real=True))
-            self.units[n] = unit
-            out.append(s)
-        return tuple(out)
-
-    def parameters(self, **defaults: float) -> tuple[sp.Symbol, ...]:
-        """Declare parameters with default values, in keyword order; returns their symbols."""
-        return tuple(self.parameter(k, v) for k, v in defaults.items())
-
-    def parameter(self, name: str, default: float, doc: str = "", unit: str = "") -> sp.Symbol:
-        """Declare one parameter with its default value, an optional one-line description and unit."""
-        self._check_new_name(name, "parameter")
-        try:
-            value = float(default)
-        except (TypeError, ValueError):
-            raise ModelError(
-                f"model {self.name!r}: default of parameter {name!r} must be a number, got {default!r}"
-            ) from None
-        s = sp.Symbol(name, real=True)
-        self.params[s] = value
-        if doc:
-            self.descriptions[name] = doc
-        if unit:
-            self.units[name] = unit
-        return s
-
-    def _check_new_name(self, name: str, what: str) -> None:
-        """Every name of a model stands for one symbol: refuse one already taken — by a coordinate,
-        a velocity (``<coordinate>_dot``), a parameter, or the time ``t``."""
-        if not isinstance(name, str) or not name.isidentifier():
-            raise ModelError(f"model {self.name!r}: {what} name {name!r} is not an identifier")
-        if name == str(t):
-            raise ModelError(f"model {self.name!r}: {what} name 't' is reserved for time")
-        for s in (*self.q, *self.qd, *self.params):
-            if str(s) == name:
-                raise ModelError(f"model {self.name!r}: {what} name {name!r} is already taken")
-
-    def declare_units(self, **units: str) -> None:
-        """Units of declared coordinates or parameters by name, e.g. ``declare_units(mh="kg", a="m")``."""
-        known = {str(s) for s in [*self.q, *self.params]}
-        for name, unit in units.items():
-            if name not in known:
-                raise ModelError(f"model {self.name!r}: unit for unknown name {name!r}")
-            self.units[name] = str(unit)
-
-    def unit(self, name: str) -> str:
-        """Unit of a coordinate, velocity (``<coordinate>_dot``) or parameter by name (``""`` if
-        undeclared)."""
-        if name in self.units:
-            return self.units[name]
-        base = name[: -len("_dot")] if name.endswith("_dot") else None
-        if base is not None and base in self.units and base in {str(s) for s in self.q}:
-            return f"{self.units[base]}/{self.time_unit}"
-        return ""
-
-    def dot(self, coordinate: sp.Symbol) -> sp.Symbol:
-        """The velocity symbol of a coordinate (named ``<coordinate>_dot``)."""
-        try:
-            return self.qd[self.q.index(coordinate)]
-        except ValueError:
-            raise ModelError(f"model {self.name!r}: {coordinate} is not a coordinate") from None
 
     def dt(self, expr: Any) -> Any:
         """Total time derivative of an expression (or vector) of q and t, by the chain rule."""
@@ -363,6 +250,7 @@ class Model:
         out.q = [self.q[i] for i in keep]
         out.qd = [self.qd[i] for i in keep]
         out.params, out.units, out.descriptions = dict(self.params), dict(self.units), dict(self.descriptions)
+        out.domains = dict(self.domains)
         for qi, v in subs.items():
             bad = v.free_symbols - set(out.q) - set(self.params) - {t}
             if bad:
@@ -384,22 +272,6 @@ class Model:
         return out
 
     # ------------------------------------------------------------------ helpers
-    @property
-    def parameter_names(self) -> list[str]:
-        return [str(s) for s in self.params]
-
-    @property
-    def state_names(self) -> list[str]:
-        """State order: all coordinates, then all velocities."""
-        return [str(s) for s in self.q] + [str(s) for s in self.qd]
-
-    def symbol(self, name: str) -> sp.Symbol:
-        """Look up a coordinate, velocity or parameter symbol by name."""
-        for s in [*self.q, *self.qd, *self.params]:
-            if str(s) == name:
-                return s
-        raise ModelError(f"model {self.name!r}: no symbol named {name!r}")
-
     def _down(self) -> sp.Matrix:
         return sp.Matrix([0, -1]) if self.dims == 2 else sp.Matrix([0, 0, -1])
 

@@ -8,6 +8,7 @@ A point's height above the ground is ``n·p``; it is ahead of the stance foot wh
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -15,10 +16,14 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
+from .domain import interval
 from .hybrid import Guard, HybridSystem, Impact, Lock
 from .model import Model
 
 _AXES = {"x": 0, "y": 1, "z": 2}
+
+#: slopes a walker can stand on (rad); a slope parameter gets this domain unless it declares one
+SLOPES = interval(-math.pi / 4, math.pi / 4)
 
 
 @dataclass
@@ -43,6 +48,9 @@ class Walker(HybridSystem):
             raise ModelError(f"walker {self.name!r}: mirror must be one of x, y, z or None, got {self.mirror!r}")
         if self.hip is not None and self.hip not in self.point_names:
             raise ModelError(f"walker {self.name!r}: hip {self.hip!r} is not a point of the model")
+        for m in self.modes.values():
+            if self.slope in m.params and str(self.slope) not in m.domains:
+                m.declare_domains(**{str(self.slope): SLOPES})
 
     def frame_change(self, transition: str) -> tuple[str | None, tuple[float, float, float]]:
         shift, flip = super().frame_change(transition)

@@ -14,7 +14,7 @@ plastic impact (derived) and the swap of the legs. Parameters (Table 2): ``mh`` 
 ``a`` = ``b`` = 0.5 m, ``g`` 9.81 m/s², ``slope`` 0.05 rad.
 """
 
-from amble import Model, R, walker
+from amble import POSITIVE, Model, R, walker
 
 NAME = "compass-gait"
 POSITION = 10  # place in `amble models` (ascending)
@@ -24,6 +24,7 @@ def build():
     m = Model("compass-gait")
     st, sw = m.coordinates("stance swing")
     mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
+    m.restrict("mh m a b g", POSITIVE)
     m.point("stance_foot", (0, 0))
     hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
     m.point("stance_mass", b * R(st), mass=ml)

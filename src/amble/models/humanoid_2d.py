@@ -29,7 +29,7 @@ x* with torso (0.03, 0.05): not comparable, see kneed-biped.)
 
 import sympy as sp
 
-from amble import R, Walker
+from amble import NONNEGATIVE, POSITIVE, R, Walker
 from amble.models.kneed_biped import kneed_model, kneed_walker
 
 NAME = "humanoid-2d"
@@ -40,6 +40,8 @@ def build() -> Walker:
     m = kneed_model(NAME, "torso")
     st, sh, th, tr = m.q
     mT, lT, kT, kv, theta_d, kleg = m.parameters(mT=3.0, lT=0.5, kT=100.0, kv=10.0, theta_d=0.0, kleg=5.0)
+    m.restrict("mT lT", POSITIVE)
+    m.restrict("kT kv kleg", NONNEGATIVE)
     m.point("torso", m.points["hip"] + lT * R(tr), mass=mT, link="hip")
     m.torque(kT * (theta_d - tr) - kv * m.dot(tr), tr - st)  # Eq. 34, reacting on the stance leg
     step_length = -m.points["swing_foot"][0]  # Eq. 35: positive while the swing foot is behind

@@ -47,7 +47,7 @@ humanoid-2d gait with the coronal angles and yaw at zero converges to x*.
 
 import sympy as sp
 
-from amble import R3, Model, Walker, distance_along_slope, walker
+from amble import NONNEGATIVE, POSITIVE, R3, Model, Walker, distance_along_slope, walker
 
 NAME = "humanoid-3d"
 POSITION = 40  # place in `amble models` (ascending)
@@ -78,6 +78,8 @@ def build() -> Walker:
     k_leg, k_sc, kv_sc, k_sw, kv_sw = m.parameters(k_leg=5.0, k_sc=400.0, kv_sc=40.0, k_sw=50.0, kv_sw=20.0)
     k_t, kv_t, th_d, k_tc, kv_tc, k_y, kv_y = m.parameters(
         k_t=60.0, kv_t=20.0, torso_d=0.0, k_tc=100.0, kv_tc=20.0, k_yaw=50.0, kv_yaw=10.0)
+    m.restrict("mh m mt a b lt w g", POSITIVE)
+    m.restrict("I_xy I_z k_leg k_sc kv_sc k_sw kv_sw k_t kv_t k_tc kv_tc k_yaw kv_yaw", NONNEGATIVE)
     frame = upper_body_frame(tor, tor_c, yaw)
     pelvis = frame[:, 1]
     m.point("stance_foot", (0, 0, 0))

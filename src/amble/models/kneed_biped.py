@@ -42,7 +42,7 @@ signs (angles counter-clockwise) at best, and lies on no heel-strike section of 
 (stance + swing would be ∓0.1): it cannot be compared beyond its signs.
 """
 
-from amble import Guard, Model, R, Walker, heel_strike, height_above_slope, joint_lock
+from amble import NONNEGATIVE, POSITIVE, Guard, Model, R, Walker, heel_strike, height_above_slope, joint_lock
 
 NAME = "kneed-biped"
 POSITION = 20  # place in `amble models` (ascending)
@@ -54,6 +54,8 @@ def kneed_model(name: str, extra: str = "") -> Model:
     st, sh, th, *_ = m.coordinates("stance shank thigh " + extra)
     mh, mt, ms, a1, b1, a2, b2, It, Is, g, slope = m.parameters(
         mh=10.0, mt=3.5, ms=1.5, a1=0.25, b1=0.25, a2=0.15, b2=0.35, It=0.0, Is=0.0, g=9.81, slope=0.05)
+    m.restrict("mh mt ms a1 b1 a2 b2 g", POSITIVE)
+    m.restrict("It Is", NONNEGATIVE)
     m.point("stance_foot", (0, 0))
     m.point("stance_shank", a1 * R(st), mass=ms)
     m.point("stance_thigh", (a1 + b1 + a2) * R(st), mass=mt)

@@ -49,7 +49,18 @@ from __future__ import annotations
 
 import math
 
-from amble import Guard, HybridSystem, Impact, Model, R, distance_along_slope, height_above_slope, walker
+from amble import (
+    POSITIVE,
+    Guard,
+    HybridSystem,
+    Impact,
+    Model,
+    R,
+    distance_along_slope,
+    height_above_slope,
+    interval,
+    walker,
+)
 
 NAME = "rimless-wheel"
 POSITION = 60  # place in `amble models` (ascending)
@@ -62,6 +73,8 @@ def build() -> HybridSystem:
     m = Model("rimless-wheel")
     (th,) = m.coordinates("theta")
     mass, l, g, alpha, slope = m.parameters(m=1.0, l=1.0, g=9.81, alpha=ALPHA, slope=SLOPE)
+    m.restrict("m l g", POSITIVE)
+    m.restrict("alpha", interval(0, math.pi / 2))  # half the angle between spokes: at least two spokes
     m.point("stance_foot", (0, 0))
     hub = m.point("hub", l * R(th), mass=mass, link="stance_foot")
     # Hub → foot of the spoke 2 alpha ahead (downhill) and of the one 2 alpha behind.

@@ -19,8 +19,10 @@ from .engine import Options, Run, run
 from .trajectory import Event, Trajectory
 
 
-def parameter_vector(k: Kernels, params: Mapping[str, float] | None) -> np.ndarray:
-    """Defaults overridden by ``params``; unknown names and non-finite values are errors."""
+def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
+                     ) -> np.ndarray:
+    """Defaults overridden by ``params``; unknown names, non-finite values and (given the
+    ``system``) values outside a parameter's declared domain are :class:`ParameterError`."""
     names = k.meta["params"]
     p = np.array(k.meta["param_defaults"], dtype=float)
     if params:
@@ -34,6 +36,8 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None) -> np.ndarr
             if not math.isfinite(v):
                 raise ParameterError(f"parameter {key!r} must be finite, got {val!r}")
             p[names.index(key)] = v
+        if system is not None:
+            system.check_parameters({key: float(p[names.index(key)]) for key in params})
     if p.size == 0:
         p = np.zeros(1)
     return p
@@ -90,7 +94,7 @@ def simulate(
         A walker with no footfall for this long has fallen (s); default from the system.
     """
     k = build(system)
-    p = parameter_vector(k, params)
+    p = parameter_vector(k, params, system)
     mi, x = initial_state(system, k, x0, mode)
     if steps is not None and steps < 1:
         raise StateError(f"steps must be at least 1, got {steps}")

@@ -1,0 +1,44 @@
+"""User input as sympy expressions fit for compiled code: anything that code generation would
+fail on far from where it was written is a :class:`~amble.errors.ModelError` here, naming what it
+was (a position, a mass, a force ...)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import sympy as sp
+from sympy.core.function import AppliedUndef
+
+from ..errors import ModelError
+
+
+def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
+    """``value`` as a sympy expression fit for compiled code, or a :class:`ModelError` naming
+    ``what``: no unparsable text, no undefined functions, no infinite, undefined or complex
+    constants (code generation would fail on them far from where they were written)."""
+    try:
+        e = sp.sympify(value)
+    except (sp.SympifyError, TypeError, SyntaxError):
+        raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
+    if not isinstance(e, sp.Expr):
+        raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
+    undefined = sorted(str(f.func) for f in e.atoms(AppliedUndef))
+    if undefined:
+        raise ModelError(f"model {model!r}: {what} uses undefined function(s) {', '.join(undefined)}")
+    if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
+        raise ModelError(f"model {model!r}: {what} contains an infinite, undefined or complex value: {e}")
+    return e
+
+
+def checked_matrix(model: str, value: Any, what: str) -> sp.Matrix:
+    """A column (from a flat sequence) or a matrix (from rows, or a sympy matrix) of :func:`checked_expr`
+    entries."""
+    if isinstance(value, sp.MatrixBase):
+        rows = value.tolist()
+    elif isinstance(value, (list, tuple)):
+        rows = [list(r) if isinstance(r, (list, tuple)) else [r] for r in value]
+    else:
+        raise ModelError(f"model {model!r}: {what} must be a vector or matrix, got {value!r}")
+    if len({len(r) for r in rows}) > 1:
+        raise ModelError(f"model {model!r}: {what} has rows of different lengths")
+    return sp.Matrix([[checked_expr(model, e, what) for e in r] for r in rows])
