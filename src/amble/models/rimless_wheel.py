@@ -49,18 +49,7 @@ from __future__ import annotations
 
 import math
 
-from amble import (
-    POSITIVE,
-    Guard,
-    HybridSystem,
-    Impact,
-    Model,
-    R,
-    distance_along_slope,
-    height_above_slope,
-    interval,
-    walker,
-)
+from amble import POSITIVE, Guard, Impact, Model, R, Walker, distance_along_slope, height_above_slope, interval, walker
 
 NAME = "rimless-wheel"
 POSITION = 60  # place in `amble models` (ascending)
@@ -69,7 +58,7 @@ ALPHA = math.pi / 8
 SLOPE = 0.08
 
 
-def build() -> HybridSystem:
+def build() -> Walker:
     m = Model("rimless-wheel")
     (th,) = m.coordinates("theta")
     mass, l, g, alpha, slope = m.parameters(m=1.0, l=1.0, g=9.81, alpha=ALPHA, slope=SLOPE)
