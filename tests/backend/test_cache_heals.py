@@ -115,3 +115,11 @@ def test_compiler_failures_say_what_happened(tmp_path, monkeypatch, cc, said):
     s = _pendulum(f"cc-{cc}")
     with pytest.raises(CompileError, match=said):
         cache.rebuild(s, kernels.structure_key(s))
+
+
+def test_a_blank_cc_means_find_a_compiler(tmp_path, monkeypatch):
+    monkeypatch.setenv("AMBLE_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("CC", "   ")  # was an IndexError
+    s = _pendulum("cc-blank")
+    so, _ = cache.rebuild(s, kernels.structure_key(s))
+    assert so.is_file()

@@ -143,7 +143,7 @@ def compiler() -> str:
 
 @lru_cache(maxsize=16)
 def _find_compiler(env_cc: str, path: str) -> str:
-    cc = env_cc or next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
+    cc = env_cc.strip() or next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
     if cc is None or shutil.which(cc.split()[0]) is None:
         raise CompileError(
             "no C compiler found: amble compiles each model to native code; install gcc or clang "
