@@ -6,14 +6,34 @@
  * built, the samples redone on it, and each bracketed crossing refined by the Illinois method.
  * The event is the earliest crossing whose enabling condition holds there.
  *
- * Needs from the including unit: dop853.h, the ST_* codes, NTR, NSUB_MAX, MODE_NTR, MODE_TR0,
- * TR_DIR and guards, guards_dot, enabled.
+ * Needs from the including unit: dop853.h, the ST_* codes, NTR, NSWMAX, NSUB_MAX, MODE_NTR,
+ * MODE_TR0, MODE_NSW, TR_DIR and guards, guards_dot, switches, switches_dot, enabled.
  */
 #ifndef AMBLE_EVENTS_H
 #define AMBLE_EVENTS_H
 
-#define NTR1 (NTR > 0 ? NTR : 1)
-#define NSAMP_MAX (NSUB_MAX + 1 + 2 * NTR)
+/* The surfaces of a mode: its transitions' guards (indices 0 .. MODE_NTR-1), then the switching
+ * surfaces of its right-hand side (events without a reset; both directions, always enabled). */
+#define NTR1 (NTR + NSWMAX > 0 ? NTR + NSWMAX : 1)
+#define NSAMP_MAX (NSUB_MAX + 1 + 2 * (NTR + NSWMAX))
+
+static int n_surf(int mode) { return MODE_NTR[mode] + MODE_NSW[mode]; }
+
+static void surfaces(int mode, double t, const double *x, const double *p, double *g) {
+    guards(mode, t, x, p, g);
+    if (MODE_NSW[mode] > 0) switches(mode, t, x, p, g + MODE_NTR[mode]);
+}
+
+static void surfaces_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g) {
+    guards_dot(mode, t, x, dx, p, g);
+    if (MODE_NSW[mode] > 0) switches_dot(mode, t, x, dx, p, g + MODE_NTR[mode]);
+}
+
+static int surf_dir(int mode, int k) { return k < MODE_NTR[mode] ? TR_DIR[MODE_TR0[mode] + k] : 0; }
+
+static int surf_enabled(int mode, int k, double t, const double *x, const double *p) {
+    return k < MODE_NTR[mode] ? enabled(MODE_TR0[mode] + k, t, x, p) : 1;
+}
 
 static int crosses(int dir, double ga, double gb) {
     if (dir < 0) return ga > 0.0 && gb <= 0.0;
@@ -25,7 +45,7 @@ static int crosses(int dir, double ga, double gb) {
 static double guard_at(const Dop *s, int mode, int k, double t, const double *p, double *xbuf) {
     double g[NTR1];
     dop_dense_eval(s, t, xbuf);
-    guards(mode, t, xbuf, p, g);
+    surfaces(mode, t, xbuf, p, g);
     return g[k];
 }
 
@@ -88,26 +108,27 @@ static void sample_guards(const Dop *s, int mode, const double *p, double t, int
     for (int j = 1; j < ns - 1; ++j) {
         if (dense) dop_dense_eval(s, t + s->h * th[j], xs);
         else hermite_eval(s, th[j], xs);
-        guards(mode, t + s->h * th[j], xs, p, gs[j]);
+        surfaces(mode, t + s->h * th[j], xs, p, gs[j]);
     }
 }
 
 /* Does any guard of the mode cross in its direction between two consecutive samples? */
-static int any_crossing(int ntr, int tr0, int ns, double gs[][NTR1]) {
-    for (int k = 0; k < ntr; ++k)
+static int any_crossing(int mode, int ns, double gs[][NTR1]) {
+    for (int k = 0; k < n_surf(mode); ++k)
         for (int j = 0; j + 1 < ns; ++j)
-            if (crosses(TR_DIR[tr0 + k], gs[j][k], gs[j + 1][k])) return 1;
+            if (crosses(surf_dir(mode, k), gs[j][k], gs[j + 1][k])) return 1;
     return 0;
 }
 
-/* The earliest enabled crossing over the samples (dense output ready): returns its guard index
- * within the mode (or -1) and sets *t_ev and x_ev. */
+/* The earliest enabled crossing over the samples (dense output ready): returns its surface index
+ * within the mode (or -1) and sets *t_ev, x_ev and *from (the surface's value before it). */
 static int first_enabled_crossing(const Dop *s, int mode, const double *p, double t, double t_new, int ns,
-                                  const double *th, double gs[][NTR1], double *t_ev, double *x_ev) {
-    const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+                                  const double *th, double gs[][NTR1], double *t_ev, double *x_ev,
+                                  double *from) {
+    const int nsf = n_surf(mode);
     int ev_k = -1;
-    for (int k = 0; k < ntr; ++k) {
-        int dir = TR_DIR[tr0 + k];
+    for (int k = 0; k < nsf; ++k) {
+        int dir = surf_dir(mode, k);
         for (int j = 0; j + 1 < ns; ++j) {
             double ta = t + s->h * th[j], tb = (j + 2 == ns) ? t_new : t + s->h * th[j + 1];
             if (ta >= *t_ev) break;
@@ -117,9 +138,10 @@ static int first_enabled_crossing(const Dop *s, int mode, const double *p, doubl
             double xr[NXMAX];
             if (tr >= t_new) { tr = t_new; for (int i = 0; i < s->n; ++i) xr[i] = s->y[i]; }
             else dop_dense_eval(s, tr, xr);
-            if (enabled(tr0 + k, tr, xr, p)) {
+            if (surf_enabled(mode, k, tr, xr, p)) {
                 *t_ev = tr;
                 ev_k = k;
+                *from = gs[j][k];
                 for (int i = 0; i < s->n; ++i) x_ev[i] = xr[i];
                 break;
             }
@@ -133,21 +155,21 @@ static int first_enabled_crossing(const Dop *s, int mode, const double *p, doubl
  * ST_SINGULAR_MASS (the dense output could not be built). */
 static int find_event(Dop *s, int mode, const double *p, int nsub, double t, double t_new,
                       const double *g_old, const double *gd_old, const double *g_new, double *gd_new,
-                      int *ev_k, double *t_ev, double *x_ev) {
-    const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+                      int *ev_k, double *t_ev, double *x_ev, double *from) {
+    const int ntr = n_surf(mode);
     *ev_k = -1;
     *t_ev = INFINITY;
     if (ntr <= 0) return 0;
     double th[NSAMP_MAX];
-    guards_dot(mode, t_new, s->y, s->f, p, gd_new);
+    surfaces_dot(mode, t_new, s->y, s->f, p, gd_new);
     const int ns = sample_times(s->h, ntr, nsub, g_old, gd_old, g_new, gd_new, th);
     double gs[NSAMP_MAX][NTR1];
     for (int k = 0; k < ntr; ++k) { gs[0][k] = g_old[k]; gs[ns - 1][k] = g_new[k]; }
     sample_guards(s, mode, p, t, ns, th, 0, gs);
-    if (!any_crossing(ntr, tr0, ns, gs)) return 0;
+    if (!any_crossing(mode, ns, gs)) return 0;
     if (dop_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
     sample_guards(s, mode, p, t, ns, th, 1, gs);
-    *ev_k = first_enabled_crossing(s, mode, p, t, t_new, ns, th, gs, t_ev, x_ev);
+    *ev_k = first_enabled_crossing(s, mode, p, t, t_new, ns, th, gs, t_ev, x_ev, from);
     return 0;
 }
 
