@@ -68,6 +68,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     double g_old[NTR1], gd_old[NTR1], gd_new[NTR1];
     surfaces(mode, t, s.y_old, p, g_old);
     surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
+    arm_zero_guards(mode, g_old, gd_old, -1);
     int status = -1;
 
     while (status < 0) {
@@ -88,7 +89,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         surfaces(mode, t_new, s.y, p, g_new);
         int ev_k;
         double t_ev, x_ev[NXMAX], from = 0.0;
-        if ((st = find_event(&s, mode, p, nsub, t, t_new, g_old, gd_old, g_new, gd_new, &ev_k, &t_ev, x_ev, &from))) {
+        if ((st = find_event(&s, mode, p, nsub, t, t_new, g_old, gd_old, g_new, gd_new, &ev_k, &t_ev, x_ev, &from, ctx[CX_TLAST_STEP],
+                            8.0 * atol, 8.0 * rtol))) {
             status = st;
             break;
         }
@@ -164,6 +166,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         }
         if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
         ctx[CX_TPREV_EVENT] = t_ev;
+        const int fired = target == mode ? ev_k : -1;
         mode = target;
         s.n = MODE_NX[mode];
         t = t_ev;
@@ -173,6 +176,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
         surfaces(mode, t, s.y_old, p, g_old);
         surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
+        arm_zero_guards(mode, g_old, gd_old, fired);
         if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) { status = ST_ZENO; break; }
         if (max_steps > 0 && ctx[CX_STEPS] >= max_steps) { status = ST_STEPS_DONE; break; }
         if (max_events > 0 && ctx[CX_EVENTS] >= max_events) { status = ST_MAX_EVENTS; break; }
