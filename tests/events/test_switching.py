@@ -33,7 +33,7 @@ def test_switching_controller_ends_sliding_instead_of_hanging():
     assert tr.status in ("end_time", "sliding"), tr.message
     assert tr2.status == "sliding", tr2.message
     th, thd = tr2.final_state
-    assert abs(th + 0.5 * thd) < 1e-9  # on the surface θ + θ̇/2 = 0
+    assert abs(th + 0.5 * thd) < 1e-8  # on the surface θ + θ̇/2 = 0, to the integration tolerance
     assert "sliding on switching surface" in tr2.message and "\n" not in tr2.message
     assert tr2.t.size < 2000  # a bounded number of integrator steps
     # before reaching it, the flow is the smooth one of the +surface side: θ̈ = −g sin θ − 20
@@ -56,7 +56,7 @@ def test_coulomb_friction_sticks_where_the_closed_form_says():
         th = brentq(f, th + sgn * 1e-9, th + sgn * 2 * abs(th) + sgn * 1e-3 if th != 0 else sgn * 3.0)
     tr = amble.simulate(coulomb_pendulum(), [th0, 0.0], t_end=30.0, sample_dt=0.0, options=_BUDGET)
     assert tr.status == "sliding", tr.message
-    assert abs(tr.final_state[1]) < 1e-9
+    assert abs(tr.final_state[1]) < 1e-8
     assert abs(tr.final_state[0] - th) < 1e-8
     assert tr.t.size < 5000
 

@@ -118,16 +118,18 @@ def walker(
     max_step_time: float = 5.0,
     mirror: str | None = None,
     doc: str = "",
+    margin: Any = None,
 ) -> Walker:
     """A one-mode walker: heel strike of ``foot`` on the slope (a step) and a fall of ``hip``.
 
     ``start`` is the default initial state, ``guess`` the default fixed-point guess (both in
     ``model.state_names`` order). A walker that makes no footfall for ``max_step_time`` seconds,
-    or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`.
+    or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`; ``margin``:
+    the footfall's enabling margin, see :func:`heel_strike`.
     """
     sys_ = Walker(model.name, {model.name: model}, max_step_time=max_step_time, hip=hip, slope=slope,
                   mirror=mirror, doc=doc)
-    guard, reset = heel_strike(model, foot, slope, relabel)
+    guard, reset = heel_strike(model, foot, slope, relabel, margin)
     sys_.transition("heel_strike", model.name, guard, reset, step=True)
     sys_.terminal("hip_on_ground", model.name, Guard(height_above_slope(model, hip, slope), -1), status="fell")
     if start is not None:

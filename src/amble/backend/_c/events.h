@@ -47,7 +47,7 @@ static int surf_enabled(int mode, int k, double t, const double *x, const double
 static void arm_zero_guards(int mode, double *g, const double *gd, int fired) {
     for (int k = 0; k < MODE_NTR[mode]; ++k) {
         if (k == fired || g[k] != 0.0 || gd[k] == 0.0) continue; /* not the guard that just fired */
-        int dir = TR_DIR[MODE_TR0[mode] + k];
+        int dir = surf_dir(mode, k);
         if (dir == 0 || (dir < 0) == (gd[k] < 0.0)) g[k] = gd[k] < 0.0 ? DBL_MIN : -DBL_MIN;
     }
 }
@@ -165,6 +165,78 @@ static int first_enabled_crossing(const Dop *s, int mode, const double *p, doubl
         }
     }
     return ev_k;
+}
+
+/* ġ of switching surface k on both sides of it, at x moved off the surface along the coordinate
+ * g depends on most (by a relative 1e-9, or twice the gap |g| to it): rate[0] on the g < 0 side,
+ * rate[1] on the g > 0 side.
+ * Returns 0, or −1 if g does not depend on the state here. */
+static int side_rates(int mode, int k, double t, const double *x, const double *p, int n, double *rate,
+                      double gap) {
+    double e[NXMAX], gd[NTR1], best = 0.0, sgn = 1.0;
+    int ib = -1;
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) e[j] = i == j ? 1.0 : 0.0;
+        surfaces_dot(mode, t, x, e, p, gd);
+        if (fabs(gd[k]) > best) { best = fabs(gd[k]); ib = i; sgn = gd[k] > 0 ? 1.0 : -1.0; }
+    }
+    if (ib < 0) return -1;
+    for (int side = 0; side < 2; ++side) {
+        double xs[NXMAX], fs[NXMAX], gs[NTR1];
+        for (int j = 0; j < n; ++j) xs[j] = x[j];
+        double d = fmax(1e-9 * fmax(1.0, fabs(x[ib])), 2.0 * gap / best); /* past the surface */
+        xs[ib] += (side ? 1.0 : -1.0) * sgn * d;
+        rate[side] = 0.0;
+        if (rhs(mode, t, xs, p, fs)) continue;
+        surfaces_dot(mode, t, xs, fs, p, gs);
+        rate[side] = gs[k];
+    }
+    return 0;
+}
+
+/* A switching surface exactly zero where integration starts: the right-hand side there is one
+ * of its branches, so ġ at the point says nothing. If the flows on both sides (side_rates) point
+ * into the surface it is sliding (returns the surface index); otherwise the surface is placed on
+ * the side the flow leaves, so that the crossing is located at once. Returns −1.
+ * `fired`: a surface just crossed (its sliding test was made at the crossing). */
+static int resolve_zero_switches(int mode, double t, const double *x, const double *p, double *g, int n,
+                                 int fired) {
+    for (int k = MODE_NTR[mode]; k < n_surf(mode); ++k) {
+        if (g[k] != 0.0 || k == fired) continue;
+        double rate[2];
+        if (side_rates(mode, k, t, x, p, n, rate, 0.0)) continue;
+        if (rate[1] < 0.0 && rate[0] > 0.0) return k;
+        if (rate[1] > 0.0 && rate[0] >= 0.0) g[k] = -DBL_MIN;      /* leaves towards g > 0 */
+        else if (rate[1] <= 0.0 && rate[0] < 0.0) g[k] = DBL_MIN;  /* leaves towards g < 0 */
+    }
+    return -1;
+}
+
+/* After crossing switching surface k (from the side of sign `from`) to x: does the flow there
+ * point back into it (sliding)? At g = 0 exactly the flows of both sides decide. */
+static int slides_after_crossing(int mode, int k, double t, const double *x, const double *p, int n,
+                                 double g, double gd, double from) {
+    if (g != 0.0) return gd * from > 0.0;
+    double rate[2];
+    if (side_rates(mode, k, t, x, p, n, rate, 0.0)) return 0;
+    return rate[1] < 0.0 && rate[0] > 0.0;
+}
+
+/* A step near a sliding surface straddles it with stages on both sides and ends on the side it
+ * started, so its crossing is never seen and the steps shrink to the gap. After each step: a
+ * switching surface the flow approaches, within gap_max, with steps shrunk so far that the next
+ * one would not clearly cross it (|g| ≥ |ġ| h / 10; a clean crossing is left to event location)
+ * is tested with the flows on both sides; if both point into it the run slides there (returns
+ * its index). */
+static int approaching_slide(int mode, double t, const double *x, const double *p, int n, const double *g,
+                             const double *gd, double h, double gap_max) {
+    for (int k = MODE_NTR[mode]; k < n_surf(mode); ++k) {
+        if (!(g[k] * gd[k] < 0.0) || fabs(g[k]) < 0.1 * fabs(gd[k]) * h || fabs(g[k]) > gap_max) continue;
+        double rate[2];
+        if (side_rates(mode, k, t, x, p, n, rate, fabs(g[k]))) continue;
+        if (rate[1] < 0.0 && rate[0] > 0.0) return k;
+    }
+    return -1;
 }
 
 /* Side a surface is on before it crosses in direction dir (0: the side of g0), as ±1. */

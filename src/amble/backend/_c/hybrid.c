@@ -69,7 +69,11 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     surfaces(mode, t, s.y_old, p, g_old);
     surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
     arm_zero_guards(mode, g_old, gd_old, -1);
-    int status = -1;
+    int status = -1, zs;
+    if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
+        ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
+        status = ST_SLIDING;
+    }
 
     while (status < 0) {
         if (t >= t_end) { status = ST_END_TIME; break; }
@@ -119,20 +123,42 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }
             for (int k = 0; k < nsf; ++k) { g_old[k] = g_new[k]; gd_old[k] = gd_new[k]; }
+            if (nsf > ntr && (zs = approaching_slide(mode, t, s.y_old, p, s.n, g_old, gd_old, h_abs,
+                                                           20.0 * (atol + rtol))) >= 0) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old);
+                ctx[CX_INFO] = MODE_SW0[mode] + (zs - ntr);
+                status = ST_SLIDING;
+                break;
+            }
             continue;
         }
         if (ev_k >= ntr) {
             /* --- a switching surface: restart the integrator on its far side, or stop if the flow
              * there points back into it (sliding) --- */
             if (recording && sample_dt <= 0.0) put_row(&rec, t_ev, mode, s.n, x_ev);
+            /* crossings accumulating (a switch chattering about a kink) count towards Zeno */
+            if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
+            ctx[CX_TPREV_EVENT] = t_ev;
             t = t_ev;
             for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
             if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
             surfaces(mode, t, s.y_old, p, g_old);
             surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
-            if (gd_old[ev_k] * from > 0.0) {
+            if (slides_after_crossing(mode, ev_k, t, s.y_old, p, s.n, g_old[ev_k], gd_old[ev_k], from)) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old); /* where it ends */
                 ctx[CX_INFO] = MODE_SW0[mode] + (ev_k - ntr);
                 status = ST_SLIDING;
+                break;
+            }
+            if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, ev_k)) >= 0) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old);
+                ctx[CX_INFO] = MODE_SW0[mode] + (zs - ntr);
+                status = ST_SLIDING;
+                break;
+            }
+            if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old);
+                status = ST_ZENO;
                 break;
             }
             continue;
@@ -177,6 +203,11 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         surfaces(mode, t, s.y_old, p, g_old);
         surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
         arm_zero_guards(mode, g_old, gd_old, fired);
+        if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
+            ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
+            status = ST_SLIDING;
+            break;
+        }
         if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) { status = ST_ZENO; break; }
         if (max_steps > 0 && ctx[CX_STEPS] >= max_steps) { status = ST_STEPS_DONE; break; }
         if (max_events > 0 && ctx[CX_EVENTS] >= max_events) { status = ST_MAX_EVENTS; break; }
