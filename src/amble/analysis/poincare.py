@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..backend.kernels import Kernels, build
-from ..errors import ConvergenceError, SimulationError, StateError
+from ..errors import ConvergenceError, ModelError, SimulationError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
@@ -75,6 +75,12 @@ class LimitCycle:
         }
 
 
+#: Longest period a k-step return map is built for.
+MAX_PERIOD = 64
+#: A gait whose points move less than this fraction of the model's size over a period is at rest.
+REST_FRACTION = 1e-6
+
+
 class ReturnMap:
     """The k-step post-impact return map of a walker at fixed parameters.
 
@@ -87,6 +93,11 @@ class ReturnMap:
                  rtol: float = FIXED_POINT_TOL, atol: float = FIXED_POINT_TOL, mode: str | None = None) -> None:
         if period < 1:
             raise StateError(f"period must be at least 1, got {period}")
+        if period > MAX_PERIOD:
+            raise StateError(f"period must be at most {MAX_PERIOD}, got {period}")
+        if not any(tr.step for tr in system.transitions):
+            raise ModelError(f"system {system.name!r} has no step transition: a return map (fixed point, "
+                             f"period-k orbit) needs a transition declared with step=True")
         self.system = system
         self.k: Kernels = build(system)
         self.p = parameter_vector(self.k, params, system)
@@ -260,11 +271,13 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
     else:
         raise ConvergenceError(f"no convergence in {max_iter} iterations (residual {res:.3g})")
     xs = y
-    if np.max(np.abs(xs)) < 1e-3:
-        # On level ground the iteration can creep towards the walker at rest, where every residual is
-        # tiny because the state is: that is not a gait.
-        raise ConvergenceError("the iteration converged to the walker at rest (all states below 1e-3), not a gait")
     Px, T = P(xs)
+    _refuse_rest(system, P, xs, T)
+    lower = _lower_period(P, xs, period, tol)
+    if lower:
+        # the k-step orbit is a shorter one repeated: report that one
+        return _newton(system, ReturnMap(system, dict(zip(P.k.meta["params"], P.p.tolist())), period=lower,
+                                         rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter)
     S, E = _chart(P.section_basis(xs))
     A = _jacobian(P, xs, E, S)
     mult = np.linalg.eigvals(A)
@@ -274,3 +287,37 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
                       multipliers=mult, section_coordinates=[names[i] for i in S],
                       residual=float(np.max(np.abs(Px - xs))), iterations=it, period=period,
                       parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A, hybrid_system=system)
+
+
+def _refuse_rest(system: HybridSystem, P: ReturnMap, x: np.ndarray, T: float) -> None:
+    """A fixed point whose period takes no time or whose points do not move (a walker at rest:
+    every residual is tiny because nothing happens) is not a gait. Scale-free: the largest
+    displacement over the period, in the world frame, of the named point that moves least, against
+    the model's size (the root mean square distance of its points from the stance foot)."""
+    if not (T > 0.0):
+        raise ConvergenceError(f"the fixed point takes no time per period (step time {T:.3g}): not a gait")
+    tr = simulate(system, x, params=dict(zip(P.k.meta["params"], P.p.tolist())), steps=P.period, t_end=2 * T,
+                  sample_dt=T / (20 * P.period), rtol=P.opts.rtol, atol=P.opts.atol)
+    world = tr.world_points()
+    if not world:
+        return
+    pos = np.stack(list(world.values()), axis=1)  # rows × points × 3
+    pos = np.nan_to_num(pos)
+    size = math.sqrt(float(np.mean(np.sum(pos[0] ** 2, axis=1))))
+    # each point's largest excursion; the least-moving point decides (a relabelled foot jumps
+    # by a step even when nothing moves, the hip of a resting walker does not)
+    moved = float(np.min(np.max(np.linalg.norm(pos - pos[0], axis=2), axis=0)))
+    if size > 0 and moved <= REST_FRACTION * size:
+        raise ConvergenceError(f"the fixed point is at rest (its points move {moved:.3g} over a period of "
+                               f"{T:.3g} s, the model measures {size:.3g}): not a gait")
+
+
+def _lower_period(P: ReturnMap, x: np.ndarray, period: int, tol: float) -> int:
+    """The smallest proper divisor d of ``period`` with P_d(x) = x (within 100 tol), or 0."""
+    for d in range(1, period):
+        if period % d:
+            continue
+        r = run(P.k, P.p, P.mi, x, steps=d, opts=P.opts)
+        if r.completed and r.mode == P.mi and np.max(np.abs(r.x - x)) < 100 * tol:
+            return d
+    return 0

@@ -26,6 +26,10 @@ STATUS: tuple[tuple[int, str, str | None], ...] = (
     (8, "MAX_EVENTS", "max_events"),
     (9, "SINGULAR_MASS", "singular_mass"),
     (10, "RESET_FAILED", "reset_failed"),
+    (11, "STALLED", "stalled"),                     # integrator steps between transitions exhausted
+    (12, "MAX_ISTEPS", "max_integrator_steps"),     # integrator steps of the whole run exhausted
+    (13, "YIELD", None),                            # periodic return to Python (signals), then resume
+    (14, "SLIDING", "sliding"),                     # the flow points into a switching surface from both sides
 )
 
 #: Fields of ``ctx`` (float64), the resumable state of a run, in index order; the state vector
@@ -43,6 +47,8 @@ CTX_FIELDS: tuple[str, ...] = (
     "GRID_T0",      # time of output-grid sample 0
     "INFO",         # transition index of a terminal or failed reset
     "FRESH",        # 1: the initial row is still to be recorded
+    "ISTEPS",       # accepted integrator steps of the run
+    "ISTEPS_EV",    # accepted integrator steps since the last transition
 )
 CTX_X = 16
 
@@ -50,7 +56,8 @@ CTX_X = 16
 OPT_FIELDS: tuple[str, ...] = ("TEND", "RTOL", "ATOL", "MAXSTEP", "MAXSTEPTIME", "SAMPLEDT", "ZENODT")
 
 #: Fields of ``iopt`` (int64), in index order.
-IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZENON", "NSUB")
+IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZENON", "NSUB",
+                                "MAXISTEPS", "MAXISTEPS_EV", "YIELDN")
 
 CTX = {name: i for i, name in enumerate(CTX_FIELDS)}
 OPT = {name: i for i, name in enumerate(OPT_FIELDS)}

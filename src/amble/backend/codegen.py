@@ -19,6 +19,7 @@ from sympy.printing.c import C99CodePrinter
 
 from ..derivation.equations import Equations, derive
 from ..derivation.impact import impulse_data
+from ..derivation.switching import switching_surfaces
 from ..modelling.hybrid import Explicit, HybridSystem, target_exprs
 from ..modelling.model import Model, t
 from . import abi
@@ -93,6 +94,11 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         tr0.append(acc)
         acc += len(trs_by_mode[name])
     ntr = len(order)
+    switches = {name: _mode_switches(mi) for name, mi in modes.items()}
+    sw0, acc = [], 0
+    for name in modes:
+        sw0.append(acc)
+        acc += len(switches[name])
 
     out: list[str] = []
     w = out.append
@@ -103,6 +109,9 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
     w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
     w(f"static const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")
     w(f"static const int MODE_TR0[NMODES] = {{{', '.join(map(str, tr0))}}};\n")
+    w(f"#define NSWMAX {max(len(v) for v in switches.values())}\n")
+    w(f"static const int MODE_NSW[NMODES] = {{{', '.join(str(len(switches[m])) for m in modes)}}};\n")
+    w(f"static const int MODE_SW0[NMODES] = {{{', '.join(map(str, sw0))}}};\n")
     arr = lambda vals: ", ".join(map(str, vals)) if vals else "0"
     w(f"static const int TR_DIR[NTR > 0 ? NTR : 1] = {{{arr([tr.guard.direction for tr in order])}}};\n")
     w(f"static const int TR_TERMINAL[NTR > 0 ? NTR : 1] = {{{arr([int(tr.terminal is not None) for tr in order])}}};\n")
@@ -149,6 +158,17 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         w(f"static void guards_dot_{k}(double t, const double *x, const double *dx, const double *p, double *g) {{\n")
         w("    (void)t; (void)x; (void)dx; (void)p; (void)g;\n")
         w(_block([f"g[{i}]" for i in range(len(trs))], gdot, nm_d))
+        w("}\n")
+        # switching surfaces of the right-hand side and their rates (events without a reset)
+        sws = switches[name]
+        w(f"static void switches_{k}(double t, const double *x, const double *p, double *s) {{\n")
+        w("    (void)t; (void)x; (void)p; (void)s;\n")
+        w(_block([f"s[{i}]" for i in range(len(sws))], sws, nm))
+        w("}\n")
+        sdot = [sp.diff(e, t) + sum((sp.diff(e, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)) for e in sws]
+        w(f"static void switches_dot_{k}(double t, const double *x, const double *dx, const double *p, double *s) {{\n")
+        w("    (void)t; (void)x; (void)dx; (void)p; (void)s;\n")
+        w(_block([f"s[{i}]" for i in range(len(sws))], sdot, nm_d))
         w("}\n")
         # energies
         if eq.K is not None:
@@ -205,6 +225,10 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
              "guards_{}(t, x, p, g)", mode_list, "mode")
     dispatch("guards_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g)",
              "void", "guards_dot_{}(t, x, dx, p, g)", mode_list, "mode")
+    dispatch("switches(int mode, double t, const double *x, const double *p, double *s)", "void",
+             "switches_{}(t, x, p, s)", mode_list, "mode")
+    dispatch("switches_dot(int mode, double t, const double *x, const double *dx, const double *p, double *s)",
+             "void", "switches_dot_{}(t, x, dx, p, s)", mode_list, "mode")
     dispatch("dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G)",
              "void", "dynamics_{}(t, x, p, M, h, G)", mode_list, "mode")
     dispatch("energy(int mode, double t, const double *x, const double *p, double *out)", "void",
@@ -237,8 +261,16 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
             for tr in order
         ],
         "dims": system.dims,
+        "switches": [{"mode": mn, "expr": str(e)} for mn in mode_list for e in switches[mn]],
     }
     return "".join(out), meta
+
+
+def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
+    """Switching surfaces of a mode's right-hand side (forces, controllers, the mass matrix)."""
+    eq, m = mi.equations, mi.model
+    exprs = [*eq.Gamma, *eq.h, *eq.M]
+    return switching_surfaces(exprs, [*m.q, *m.qd, t])
 
 
 def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict, params: list[str]) -> str:

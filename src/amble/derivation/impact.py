@@ -55,8 +55,18 @@ def extended_impact_data(model: Model, equations: Equations, point: str) -> tupl
             f"model {model.name!r}: an Impact reset needs the kinetic energy from point masses "
             "(K or L was given outright); give an Explicit reset instead"
         )
-    # Added kinetic terms (rotational inertia) do not depend on the base translation, so they
-    # stay in the q-block M and contribute nothing to the base blocks.
+    if model._k_added:
+        # ½ m_H |ṗ_hip|² and ½ m_H l² θ̇² are the same expression in q̇, but only the first carries
+        # linear momentum into the impact: the expression cannot tell which it is.
+        raise ModelError(
+            f"model {model.name!r}: an Impact reset cannot use kinetic terms added with add_kinetic "
+            f"({len(model._k_added)} term(s)): from the expression alone it cannot tell whether a term is "
+            "a translating mass (whose momentum the impact changes) or rotational inertia; declare "
+            "masses with point(..., mass=...) and rotational inertia with inertia() or body_inertia(), "
+            "or give an Explicit reset"
+        )
+    # Rotational inertia (inertia(), body_inertia()) does not depend on the base translation, so
+    # it stays in the q-block M and contributes nothing to the base blocks.
     n, d = len(model.q), model.dims
     S = sp.zeros(n, d)
     mt = sp.Integer(0)

@@ -53,6 +53,7 @@ class Model(Names):
         self.masses: dict[str, sp.Expr] = {}
         self.links: list[tuple[str, str]] = []
         self._k_terms: list[sp.Expr] = []
+        self._k_added: list[sp.Expr] = []  # the add_kinetic terms among them (not rotational inertia)
         self._v_terms: list[sp.Expr] = []
         self._k_override: sp.Expr | None = None
         self._v_override: sp.Expr | None = None
@@ -146,6 +147,7 @@ class Model(Names):
     def add_kinetic(self, expr: Any) -> None:
         """Add a kinetic-energy term (J) in q and the velocity symbols."""
         self._k_terms.append(_expr(self.name, expr, "kinetic energy term"))
+        self._k_added.append(self._k_terms[-1])
 
     def add_potential(self, expr: Any) -> None:
         """Add a potential-energy term (J) in q, e.g. a spring ``k*(q1 - q2)**2/2``."""
@@ -261,6 +263,7 @@ class Model(Names):
         out.masses = dict(self.masses)
         out.links = list(self.links)
         out._k_terms = [e.subs(vsubs) for e in self._k_terms]
+        out._k_added = [e.subs(vsubs) for e in self._k_added]
         out._v_terms = [e.subs(subs) for e in self._v_terms]
         for attr in ("_k_override", "_v_override", "_l_override"):
             e = getattr(self, attr)

@@ -82,10 +82,28 @@ def distance_along_slope(model: Model, point: str, slope: Any) -> sp.Expr:
     return (d.T * model.points[point])[0, 0]
 
 
-def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any]) -> tuple[Guard, Impact]:
-    """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot,
+#: A footfall needs the foot ahead of the stance foot by this fraction of the model's size.
+STEP_MARGIN = 1e-6
+
+
+def model_size(model: Model) -> sp.Expr:
+    """A length of the model in its current configuration: the root mean square distance of its
+    named points from the origin (the stance foot) — the scale of an enabling margin."""
+    pts = list(model.points.values())
+    if not pts:
+        return sp.Integer(1)
+    return sp.sqrt(sum(((p.T * p)[0, 0] for p in pts), sp.Integer(0)) / len(pts))
+
+
+def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any],
+                margin: Any = None) -> tuple[Guard, Impact]:
+    """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot
+    by more than ``margin`` (default :data:`STEP_MARGIN` × :func:`model_size`, so that legs
+    passing each other — the foot at the stance foot up to round-off — are no footfall),
     followed by a plastic impact and the leg relabelling."""
-    guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > 0)
+    if margin is None:
+        margin = STEP_MARGIN * model_size(model)
+    guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > margin)
     return guard, Impact(foot, relabel)
 
 
@@ -108,16 +126,18 @@ def walker(
     max_step_time: float = 5.0,
     mirror: str | None = None,
     doc: str = "",
+    margin: Any = None,
 ) -> Walker:
     """A one-mode walker: heel strike of ``foot`` on the slope (a step) and a fall of ``hip``.
 
     ``start`` is the default initial state, ``guess`` the default fixed-point guess (both in
     ``model.state_names`` order). A walker that makes no footfall for ``max_step_time`` seconds,
-    or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`.
+    or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`; ``margin``:
+    the footfall's enabling margin, see :func:`heel_strike`.
     """
     sys_ = Walker(model.name, {model.name: model}, max_step_time=max_step_time, hip=hip, slope=slope,
                   mirror=mirror, doc=doc)
-    guard, reset = heel_strike(model, foot, slope, relabel)
+    guard, reset = heel_strike(model, foot, slope, relabel, margin)
     sys_.transition("heel_strike", model.name, guard, reset, step=True)
     sys_.terminal("hip_on_ground", model.name, Guard(height_above_slope(model, hip, slope), -1), status="fell")
     if start is not None:

@@ -28,6 +28,9 @@ class Options:
     previous one end the run as ``zeno``. max_events: hard cap on events. nsub: uniform guard
     samples per integration step, in addition to the extremum of the cubic through ``g`` and ``ġ``
     at both step ends (which already finds a guard dipping through zero and back inside a step).
+    max_integrator_steps: cap on accepted integrator steps of a run (status
+    ``max_integrator_steps``); max_steps_between_events: cap on accepted steps between two
+    transitions (status ``stalled``: a stiff or chattering run). 0: no cap.
     """
 
     rtol: float = 1e-10
@@ -38,6 +41,8 @@ class Options:
     zeno_events: int = 5
     max_events: int = 1_000_000
     nsub: int = 1
+    max_integrator_steps: int = 20_000_000
+    max_steps_between_events: int = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -97,17 +102,35 @@ def run(
     opt = np.array([opt_values[f] for f in OPT_FIELDS], dtype=float)
     cap, ecap = (1024, 64) if record else (0, 0)
     buf = _Buffers(cap, ecap, nxm)
-    while True:
-        iopt_values = {"MAXSTEPS": steps, "MAXEVENTS": opts.max_events, "OUTCAP": buf.cap, "EVCAP": buf.ecap,
-                       "ZENON": opts.zeno_events, "NSUB": opts.nsub}
-        iopt = np.array([iopt_values[f] for f in IOPT_FIELDS], dtype=np.int64)
-        code = buf.call(k, p, ctx, opt, iopt)
-        if code != CODE["BUFFER_FULL"]:
-            break
-        buf.grow()
+    code = CODE["YIELD"]
+    try:
+        while True:
+            iopt_values = {"MAXSTEPS": steps, "MAXEVENTS": opts.max_events, "OUTCAP": buf.cap, "EVCAP": buf.ecap,
+                           "ZENON": opts.zeno_events, "NSUB": opts.nsub, "MAXISTEPS": opts.max_integrator_steps,
+                           "MAXISTEPS_EV": opts.max_steps_between_events, "YIELDN": YIELD_STEPS}
+            iopt = np.array([iopt_values[f] for f in IOPT_FIELDS], dtype=np.int64)
+            code = buf.call(k, p, ctx, opt, iopt)
+            if code == CODE["BUFFER_FULL"]:
+                buf.grow()
+            elif code != CODE["YIELD"]:
+                break
+    except KeyboardInterrupt as exc:
+        # Ctrl-C between two compiled calls: the run so far stays reachable as ``exc.run``
+        exc.run = _result(k, CODE["YIELD"], ctx, buf)  # type: ignore[attr-defined]
+        raise
+    return _result(k, code, ctx, buf)
+
+
+#: Accepted integrator steps per compiled call: the loop returns this often so that Python can
+#: handle signals (Ctrl-C), then resumes exactly where it stopped.
+YIELD_STEPS = 20_000
+
+
+def _result(k: Kernels, code: int, ctx: np.ndarray, buf: _Buffers) -> Run:
     mi = int(ctx[CTX["MODE"]])
-    info = int(ctx[CTX["INFO"]]) if code in (CODE["TERMINAL"], CODE["RESET_FAILED"]) else -1
-    return Run(code=code, status=outcome(k, code, info), t=float(ctx[CTX["T"]]), mode=mi,
+    info = int(ctx[CTX["INFO"]]) if code in (CODE["TERMINAL"], CODE["RESET_FAILED"], CODE["SLIDING"]) else -1
+    status = "interrupted" if code == CODE["YIELD"] else outcome(k, code, info)
+    return Run(code=code, status=status, t=float(ctx[CTX["T"]]), mode=mi,
                x=ctx[CTX_X : CTX_X + k.meta["nx"][mi]].copy(), steps=int(ctx[CTX["STEPS"]]),
                events=int(ctx[CTX["EVENTS"]]), info=info, ctx=ctx, recorded=buf.result())
 

@@ -6,6 +6,7 @@ The compiled run itself is :func:`amble.simulation.engine.run`, the lean core th
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 
@@ -109,10 +110,16 @@ def simulate(
         if not (v > 0 and math.isfinite(v)):
             raise StateError(f"{name} must be a positive number, got {v}")
     mst = max_step_time if max_step_time is not None else system.max_step_time
-    opts = Options(rtol=rtol, atol=atol, max_step=base.max_step, max_step_time=mst, zeno_dt=base.zeno_dt,
-                   zeno_events=base.zeno_events, max_events=base.max_events, nsub=base.nsub)
-    r = run(k, p, mi, x, t_end=t_end if t_end is not None else math.inf, steps=steps or 0, opts=opts,
-            sample_dt=sample_dt, record=True)
+    opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=mst)
+    try:
+        r = run(k, p, mi, x, t_end=t_end if t_end is not None else math.inf, steps=steps or 0, opts=opts,
+                sample_dt=sample_dt, record=True)
+    except KeyboardInterrupt as exc:
+        partial = getattr(exc, "run", None)
+        if partial is not None:  # the run so far, as ``exc.trajectory``
+            exc.trajectory = _trajectory(k, p, partial, opts)  # type: ignore[attr-defined]
+            exc.trajectory.system = system  # type: ignore[attr-defined]
+        raise
     traj = _trajectory(k, p, r, opts)
     traj.system = system
     return traj
@@ -128,8 +135,8 @@ def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
         ns, nt = meta["nx"][meta["modes"].index(info["source"])], meta["nx"][meta["modes"].index(info["target"])]
         events.append(Event(float(t), info["name"], info["source"], info["target"], pre[:ns].copy(), post[:nt].copy()))
     return Trajectory(t=rec["t"], mode=rec["mode"], x=rec["x"], events=events, status=r.status,
-                      message=_message(r, opts, trs), steps=r.steps, params=p, kernels=k, final_state=r.x,
-                      final_mode=meta["modes"][r.mode])
+                      message=_message(r, opts, trs, meta.get("switches", [])), steps=r.steps, params=p,
+                      kernels=k, final_state=r.x, final_mode=meta["modes"][r.mode])
 
 
 #: How each way of ending reads, by status name (:data:`amble.backend.abi.STATUS`).
@@ -144,12 +151,24 @@ _MESSAGES = {
     "SINGULAR_MASS": "mass matrix singular or ill-conditioned at t = {t:.9g} s, state {x}",
     "RESET_FAILED": "reset of {transition!r} failed at t = {t:.9g} s",
     "MAX_EVENTS": "{events} events, the most allowed, at t = {t:.6g} s",
+    "STALLED": "{max_steps_between_events} integrator steps without a transition, the most allowed, at t = {t:.9g} s",
+    "MAX_ISTEPS": "{max_integrator_steps} integrator steps, the most allowed, at t = {t:.9g} s",
+    "YIELD": "interrupted at t = {t:.9g} s",
+    "SLIDING": "sliding on switching surface {surface} ({surface_expr}) at t = {t:.9g} s",
 }
 
 
-def _message(r: Run, opts: Options, trs: list) -> str:
+def _message(r: Run, opts: Options, trs: list, switches: list) -> str:
     name = next(n for n, c in CODE.items() if c == r.code)
     template = _MESSAGES.get(name, "stopped at t = {t:.6g} s")
     return template.format(t=r.t, steps=r.steps, events=r.events, x=r.x.tolist(), max_step_time=opts.max_step_time,
                            zeno_events=opts.zeno_events, zeno_dt=opts.zeno_dt,
-                           transition=trs[r.info]["name"] if r.info >= 0 else "")
+                           max_steps_between_events=opts.max_steps_between_events,
+                           max_integrator_steps=opts.max_integrator_steps, surface=r.info,
+                           surface_expr=_surface(r, switches),
+                           transition=trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "")
+
+
+def _surface(r: Run, switches: list) -> str:
+    """The switching surface a ``sliding`` run ended on, as derived from the model."""
+    return str(switches[r.info]["expr"]) if r.code == CODE["SLIDING"] and 0 <= r.info < len(switches) else ""

@@ -6,14 +6,51 @@
  * built, the samples redone on it, and each bracketed crossing refined by the Illinois method.
  * The event is the earliest crossing whose enabling condition holds there.
  *
- * Needs from the including unit: dop853.h, the ST_* codes, NTR, NSUB_MAX, MODE_NTR, MODE_TR0,
- * TR_DIR and guards, guards_dot, enabled.
+ * Needs from the including unit: dop853.h, the ST_* codes, NTR, NSWMAX, NSUB_MAX, MODE_NTR,
+ * MODE_TR0, MODE_NSW, TR_DIR and guards, guards_dot, switches, switches_dot, enabled.
  */
 #ifndef AMBLE_EVENTS_H
 #define AMBLE_EVENTS_H
+#include <float.h>
 
-#define NTR1 (NTR > 0 ? NTR : 1)
-#define NSAMP_MAX (NSUB_MAX + 1 + 2 * NTR)
+/* The surfaces of a mode: its transitions' guards (indices 0 .. MODE_NTR-1), then the switching
+ * surfaces of its right-hand side (events without a reset; both directions, always enabled). */
+#define NTR1 (NTR + NSWMAX > 0 ? NTR + NSWMAX : 1)
+#define NSAMP_MAX (NSUB_MAX + 1 + 2 * (NTR + NSWMAX))
+
+static int n_surf(int mode) { return MODE_NTR[mode] + MODE_NSW[mode]; }
+
+static void surfaces(int mode, double t, const double *x, const double *p, double *g) {
+    guards(mode, t, x, p, g);
+    if (MODE_NSW[mode] > 0) switches(mode, t, x, p, g + MODE_NTR[mode]);
+}
+
+static void surfaces_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g) {
+    guards_dot(mode, t, x, dx, p, g);
+    if (MODE_NSW[mode] > 0) switches_dot(mode, t, x, dx, p, g + MODE_NTR[mode]);
+}
+
+static int surf_dir(int mode, int k) { return k < MODE_NTR[mode] ? TR_DIR[MODE_TR0[mode] + k] : 0; }
+
+/* A step transition also needs a step of non-zero duration: t after t_min (the last step). */
+static int surf_enabled(int mode, int k, double t, const double *x, const double *p, double t_min) {
+    if (k >= MODE_NTR[mode]) return 1;
+    if (TR_STEP[MODE_TR0[mode] + k] && !(t > t_min)) return 0;
+    return enabled(MODE_TR0[mode] + k, t, x, p);
+}
+
+/* A guard exactly zero where a mode is entered (after a reset, at the start) cannot be seen
+ * crossing from its pre-crossing side: if ġ there points across it in its direction, the
+ * crossing is genuine and the guard is placed on the pre-crossing side by the smallest amount.
+ * `fired`: index within the mode of a transition that just fired into its own mode, which is
+ * left alone (it sits on its own root). */
+static void arm_zero_guards(int mode, double *g, const double *gd, int fired) {
+    for (int k = 0; k < MODE_NTR[mode]; ++k) {
+        if (k == fired || g[k] != 0.0 || gd[k] == 0.0) continue; /* not the guard that just fired */
+        int dir = surf_dir(mode, k);
+        if (dir == 0 || (dir < 0) == (gd[k] < 0.0)) g[k] = gd[k] < 0.0 ? DBL_MIN : -DBL_MIN;
+    }
+}
 
 static int crosses(int dir, double ga, double gb) {
     if (dir < 0) return ga > 0.0 && gb <= 0.0;
@@ -25,7 +62,7 @@ static int crosses(int dir, double ga, double gb) {
 static double guard_at(const Dop *s, int mode, int k, double t, const double *p, double *xbuf) {
     double g[NTR1];
     dop_dense_eval(s, t, xbuf);
-    guards(mode, t, xbuf, p, g);
+    surfaces(mode, t, xbuf, p, g);
     return g[k];
 }
 
@@ -88,26 +125,27 @@ static void sample_guards(const Dop *s, int mode, const double *p, double t, int
     for (int j = 1; j < ns - 1; ++j) {
         if (dense) dop_dense_eval(s, t + s->h * th[j], xs);
         else hermite_eval(s, th[j], xs);
-        guards(mode, t + s->h * th[j], xs, p, gs[j]);
+        surfaces(mode, t + s->h * th[j], xs, p, gs[j]);
     }
 }
 
 /* Does any guard of the mode cross in its direction between two consecutive samples? */
-static int any_crossing(int ntr, int tr0, int ns, double gs[][NTR1]) {
-    for (int k = 0; k < ntr; ++k)
+static int any_crossing(int mode, int ns, double gs[][NTR1]) {
+    for (int k = 0; k < n_surf(mode); ++k)
         for (int j = 0; j + 1 < ns; ++j)
-            if (crosses(TR_DIR[tr0 + k], gs[j][k], gs[j + 1][k])) return 1;
+            if (crosses(surf_dir(mode, k), gs[j][k], gs[j + 1][k])) return 1;
     return 0;
 }
 
-/* The earliest enabled crossing over the samples (dense output ready): returns its guard index
- * within the mode (or -1) and sets *t_ev and x_ev. */
+/* The earliest enabled crossing over the samples (dense output ready): returns its surface index
+ * within the mode (or -1) and sets *t_ev, x_ev and *from (the surface's value before it). */
 static int first_enabled_crossing(const Dop *s, int mode, const double *p, double t, double t_new, int ns,
-                                  const double *th, double gs[][NTR1], double *t_ev, double *x_ev) {
-    const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+                                  const double *th, double gs[][NTR1], double *t_ev, double *x_ev,
+                                  double *from, double t_min) {
+    const int nsf = n_surf(mode);
     int ev_k = -1;
-    for (int k = 0; k < ntr; ++k) {
-        int dir = TR_DIR[tr0 + k];
+    for (int k = 0; k < nsf; ++k) {
+        int dir = surf_dir(mode, k);
         for (int j = 0; j + 1 < ns; ++j) {
             double ta = t + s->h * th[j], tb = (j + 2 == ns) ? t_new : t + s->h * th[j + 1];
             if (ta >= *t_ev) break;
@@ -117,9 +155,10 @@ static int first_enabled_crossing(const Dop *s, int mode, const double *p, doubl
             double xr[NXMAX];
             if (tr >= t_new) { tr = t_new; for (int i = 0; i < s->n; ++i) xr[i] = s->y[i]; }
             else dop_dense_eval(s, tr, xr);
-            if (enabled(tr0 + k, tr, xr, p)) {
+            if (surf_enabled(mode, k, tr, xr, p, t_min)) {
                 *t_ev = tr;
                 ev_k = k;
+                *from = gs[j][k];
                 for (int i = 0; i < s->n; ++i) x_ev[i] = xr[i];
                 break;
             }
@@ -128,26 +167,170 @@ static int first_enabled_crossing(const Dop *s, int mode, const double *p, doubl
     return ev_k;
 }
 
+/* ġ of switching surface k on both sides of it, at x moved off the surface along the coordinate
+ * g depends on most (by a relative 1e-9, or twice the gap |g| to it): rate[0] on the g < 0 side,
+ * rate[1] on the g > 0 side.
+ * Returns 0, or −1 if g does not depend on the state here. */
+static int side_rates(int mode, int k, double t, const double *x, const double *p, int n, double *rate,
+                      double gap) {
+    double e[NXMAX], gd[NTR1], best = 0.0, sgn = 1.0;
+    int ib = -1;
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) e[j] = i == j ? 1.0 : 0.0;
+        surfaces_dot(mode, t, x, e, p, gd);
+        if (fabs(gd[k]) > best) { best = fabs(gd[k]); ib = i; sgn = gd[k] > 0 ? 1.0 : -1.0; }
+    }
+    if (ib < 0) return -1;
+    for (int side = 0; side < 2; ++side) {
+        double xs[NXMAX], fs[NXMAX], gs[NTR1];
+        for (int j = 0; j < n; ++j) xs[j] = x[j];
+        double d = fmax(1e-9 * fmax(1.0, fabs(x[ib])), 2.0 * gap / best); /* past the surface */
+        xs[ib] += (side ? 1.0 : -1.0) * sgn * d;
+        rate[side] = 0.0;
+        if (rhs(mode, t, xs, p, fs)) continue;
+        surfaces_dot(mode, t, xs, fs, p, gs);
+        rate[side] = gs[k];
+    }
+    return 0;
+}
+
+/* A switching surface exactly zero where integration starts: the right-hand side there is one
+ * of its branches, so ġ at the point says nothing. If the flows on both sides (side_rates) point
+ * into the surface it is sliding (returns the surface index); otherwise the surface is placed on
+ * the side the flow leaves, so that the crossing is located at once. Returns −1.
+ * `fired`: a surface just crossed (its sliding test was made at the crossing). */
+static int resolve_zero_switches(int mode, double t, const double *x, const double *p, double *g, int n,
+                                 int fired) {
+    for (int k = MODE_NTR[mode]; k < n_surf(mode); ++k) {
+        if (g[k] != 0.0 || k == fired) continue;
+        double rate[2];
+        if (side_rates(mode, k, t, x, p, n, rate, 0.0)) continue;
+        if (rate[1] < 0.0 && rate[0] > 0.0) return k;
+        if (rate[1] > 0.0 && rate[0] >= 0.0) g[k] = -DBL_MIN;      /* leaves towards g > 0 */
+        else if (rate[1] <= 0.0 && rate[0] < 0.0) g[k] = DBL_MIN;  /* leaves towards g < 0 */
+    }
+    return -1;
+}
+
+/* After crossing switching surface k (from the side of sign `from`) to x: does the flow there
+ * point back into it (sliding)? At g = 0 exactly the flows of both sides decide. */
+static int slides_after_crossing(int mode, int k, double t, const double *x, const double *p, int n,
+                                 double g, double gd, double from) {
+    if (g != 0.0) return gd * from > 0.0;
+    double rate[2];
+    if (side_rates(mode, k, t, x, p, n, rate, 0.0)) return 0;
+    return rate[1] < 0.0 && rate[0] > 0.0;
+}
+
+/* A step near a sliding surface straddles it with stages on both sides and ends on the side it
+ * started, so its crossing is never seen and the steps shrink to the gap. After each step: a
+ * switching surface the flow approaches, within gap_max, with steps shrunk so far that the next
+ * one would not clearly cross it (|g| ≥ |ġ| h / 10; a clean crossing is left to event location)
+ * is tested with the flows on both sides; if both point into it the run slides there (returns
+ * its index). */
+static int approaching_slide(int mode, double t, const double *x, const double *p, int n, const double *g,
+                             const double *gd, double h, double gap_max) {
+    for (int k = MODE_NTR[mode]; k < n_surf(mode); ++k) {
+        if (!(g[k] * gd[k] < 0.0) || fabs(g[k]) < 0.1 * fabs(gd[k]) * h || fabs(g[k]) > gap_max) continue;
+        double rate[2];
+        if (side_rates(mode, k, t, x, p, n, rate, fabs(g[k]))) continue;
+        if (rate[1] < 0.0 && rate[0] > 0.0) return k;
+    }
+    return -1;
+}
+
+/* Side a surface is on before it crosses in direction dir (0: the side of g0), as ±1. */
+static double pre_side(int dir, double g0) { return dir < 0 ? 1.0 : dir > 0 ? -1.0 : (g0 >= 0.0 ? 1.0 : -1.0); }
+
+/* θ ∈ (0, 1) of the extremum of surface k inside the step, where ġ (ġ0 at θ = 0, ġ1 at θ = 1, of
+ * opposite signs) vanishes along the 7th-order dense output: Illinois on ġ = ∇g · f(x(θ)). */
+static double extremum_theta(const Dop *s, int mode, int k, const double *p, double gd0, double gd1) {
+    double xa[NXMAX], fa[NXMAX], gd[NTR1];
+    double ta = 0.0, tb = 1.0, fa0 = gd0, fb0 = gd1;
+    int side = 0;
+    double tm = 0.5;
+    for (int it = 0; it < 60 && tb - ta > 1e-12; ++it) {
+        tm = (fa0 * tb - fb0 * ta) / (fa0 - fb0);
+        if (!(tm > ta && tm < tb)) tm = 0.5 * (ta + tb);
+        double t = s->t_old + s->h * tm;
+        dop_dense_eval(s, t, xa);
+        if (rhs(mode, t, xa, p, fa)) break;
+        surfaces_dot(mode, t, xa, fa, p, gd);
+        if ((gd[k] < 0.0) == (fa0 < 0.0)) {
+            ta = tm; fa0 = gd[k];
+            if (side == 1) fb0 *= 0.5;
+            side = 1;
+        } else {
+            tb = tm; fb0 = gd[k];
+            if (side == -1) fa0 *= 0.5;
+            side = -1;
+        }
+    }
+    return tm;
+}
+
+/* Surfaces whose ġ turns inside the step while both ends are on their pre-crossing side: a dip
+ * towards zero that the screening may miss or see by round-off. Its extremum on the dense output
+ * decides: deeper than the integration tolerance (gtol, in g's units) it is a crossing and its
+ * time becomes a sample; otherwise (a tangency, or no crossing) the surface has no event in this
+ * step (skip[k] = 1). Returns the new number of samples. */
+static int refine_dips(Dop *s, int mode, const double *p, double gtol_abs, double gtol_rel, const double *g_old,
+                       const double *gd_old, const double *g_new, const double *gd_new, int ns, double *th,
+                       int *skip) {
+    for (int k = 0; k < n_surf(mode); ++k) {
+        double sd = pre_side(surf_dir(mode, k), g_old[k]);
+        if (!(sd * g_old[k] > 0.0 && sd * g_new[k] > 0.0 && sd * gd_old[k] < 0.0 && sd * gd_new[k] > 0.0)) continue;
+        double te = extremum_theta(s, mode, k, p, gd_old[k], gd_new[k]);
+        double xe[NXMAX], ge[NTR1];
+        dop_dense_eval(s, s->t_old + s->h * te, xe);
+        surfaces(mode, s->t_old + s->h * te, xe, p, ge);
+        double tol = gtol_abs + gtol_rel * fmax(fabs(g_old[k]), fabs(g_new[k]));
+        if (sd * ge[k] < -tol && ns < NSAMP_MAX) {
+            int j = ns++;
+            for (; j > 0 && th[j - 1] > te; --j) th[j] = th[j - 1];
+            th[j] = te;
+        } else {
+            skip[k] = 1;
+        }
+    }
+    return ns;
+}
+
 /* Event of the step just taken from (t, g_old, gd_old) to (t_new, g_new): fills gd_new (ġ at
  * t_new), sets *ev_k (guard index within the mode, or -1), *t_ev and x_ev. Returns 0 or
  * ST_SINGULAR_MASS (the dense output could not be built). */
 static int find_event(Dop *s, int mode, const double *p, int nsub, double t, double t_new,
                       const double *g_old, const double *gd_old, const double *g_new, double *gd_new,
-                      int *ev_k, double *t_ev, double *x_ev) {
-    const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+                      int *ev_k, double *t_ev, double *x_ev, double *from, double t_min,
+                      double gtol_abs, double gtol_rel) {
+    const int ntr = n_surf(mode);
     *ev_k = -1;
     *t_ev = INFINITY;
     if (ntr <= 0) return 0;
     double th[NSAMP_MAX];
-    guards_dot(mode, t_new, s->y, s->f, p, gd_new);
-    const int ns = sample_times(s->h, ntr, nsub, g_old, gd_old, g_new, gd_new, th);
+    surfaces_dot(mode, t_new, s->y, s->f, p, gd_new);
+    int ns = sample_times(s->h, ntr, nsub, g_old, gd_old, g_new, gd_new, th);
     double gs[NSAMP_MAX][NTR1];
+    int skip[NTR1], dips = 0;
+    for (int k = 0; k < ntr; ++k) {
+        skip[k] = 0;
+        double sd = pre_side(surf_dir(mode, k), g_old[k]);
+        dips |= sd * g_old[k] > 0.0 && sd * g_new[k] > 0.0 && sd * gd_old[k] < 0.0 && sd * gd_new[k] > 0.0;
+    }
     for (int k = 0; k < ntr; ++k) { gs[0][k] = g_old[k]; gs[ns - 1][k] = g_new[k]; }
     sample_guards(s, mode, p, t, ns, th, 0, gs);
-    if (!any_crossing(ntr, tr0, ns, gs)) return 0;
+    if (!any_crossing(mode, ns, gs) && !dips) return 0;
     if (dop_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
+    if (dips) {
+        int ns0 = ns;
+        ns = refine_dips(s, mode, p, gtol_abs, gtol_rel, g_old, gd_old, g_new, gd_new, ns, th, skip);
+        for (int k = 0; k < ntr; ++k) gs[ns - 1][k] = g_new[k];
+        if (ns == ns0 && !any_crossing(mode, ns, gs)) return 0;
+    }
     sample_guards(s, mode, p, t, ns, th, 1, gs);
-    *ev_k = first_enabled_crossing(s, mode, p, t, t_new, ns, th, gs, t_ev, x_ev);
+    for (int k = 0; k < ntr; ++k)
+        if (skip[k]) for (int j = 0; j < ns; ++j) gs[j][k] = g_old[k]; /* no event of surface k here */
+    *ev_k = first_enabled_crossing(s, mode, p, t, t_new, ns, th, gs, t_ev, x_ev, from, t_min);
     return 0;
 }
 

@@ -28,7 +28,10 @@
 #include "record.h"
 
 /* Simulate from the state in ctx until an end condition; see the CX_, OP_, IO_ layouts.
- * Returns a status ST_*; ST_BUFFER_FULL means "grow the buffers and call again". */
+ * Returns a status ST_*; ST_BUFFER_FULL means "grow the buffers and call again", ST_YIELD (every
+ * IO_YIELDN accepted steps) "call again" — the caller handles signals in between, the run resumes
+ * exactly where it stopped. IO_MAXISTEPS and IO_MAXISTEPS_EV cap the accepted steps of the run and
+ * between transitions (0: no cap). */
 int amble_simulate(const double *p, double *ctx, const double *opt, const int64_t *iopt,
                    double *out_t, int *out_mode, double *out_x, int64_t *n_out,
                    double *ev_t, int *ev_tr, double *ev_xpre, double *ev_xpost, int64_t *n_ev) {
@@ -38,6 +41,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     const double max_step_time = opt[OP_MAXSTEPTIME], sample_dt = opt[OP_SAMPLEDT];
     const double zeno_dt = opt[OP_ZENODT];
     const int64_t max_steps = iopt[IO_MAXSTEPS], max_events = iopt[IO_MAXEVENTS], zeno_n = iopt[IO_ZENON];
+    const int64_t max_isteps = iopt[IO_MAXISTEPS], max_isteps_ev = iopt[IO_MAXISTEPS_EV], yield_n = iopt[IO_YIELDN];
+    int64_t isteps_call = 0;
     int nsub = (int)iopt[IO_NSUB];
     if (nsub < 1) nsub = 1;
     if (nsub > NSUB_MAX) nsub = NSUB_MAX;
@@ -61,13 +66,21 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     double h_abs = ctx[CX_H];
     if (!(h_abs > 0.0)) h_abs = initial_step(mode, t, s.y_old, s.f_old, p, t_end, max_step, rtol, atol, s.n);
     double g_old[NTR1], gd_old[NTR1], gd_new[NTR1];
-    guards(mode, t, s.y_old, p, g_old);
-    guards_dot(mode, t, s.y_old, s.f_old, p, gd_old);
-    int status = -1;
+    surfaces(mode, t, s.y_old, p, g_old);
+    surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
+    arm_zero_guards(mode, g_old, gd_old, -1);
+    int status = -1, zs;
+    if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
+        ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
+        status = ST_SLIDING;
+    }
 
     while (status < 0) {
         if (t >= t_end) { status = ST_END_TIME; break; }
         if (max_step_time > 0.0 && t - ctx[CX_TLAST_STEP] >= max_step_time) { status = ST_STEP_TIMEOUT; break; }
+        if (max_isteps > 0 && ctx[CX_ISTEPS] >= (double)max_isteps) { status = ST_MAX_ISTEPS; break; }
+        if (max_isteps_ev > 0 && ctx[CX_ISTEPS_EV] >= (double)max_isteps_ev) { status = ST_STALLED; break; }
+        if (yield_n > 0 && isteps_call >= yield_n) { status = ST_YIELD; break; }
         double t_bound = t_end;
         if (max_step_time > 0.0 && ctx[CX_TLAST_STEP] + max_step_time < t_bound) t_bound = ctx[CX_TLAST_STEP] + max_step_time;
         s.t_old = t;
@@ -75,12 +88,13 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         int st = dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try);
         if (st) { status = st; break; }
         const double t_new = t + s.h;
-        const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode];
+        const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode], nsf = n_surf(mode);
         double g_new[NTR1];
-        guards(mode, t_new, s.y, p, g_new);
+        surfaces(mode, t_new, s.y, p, g_new);
         int ev_k;
-        double t_ev, x_ev[NXMAX];
-        if ((st = find_event(&s, mode, p, nsub, t, t_new, g_old, gd_old, g_new, gd_new, &ev_k, &t_ev, x_ev))) {
+        double t_ev, x_ev[NXMAX], from = 0.0;
+        if ((st = find_event(&s, mode, p, nsub, t, t_new, g_old, gd_old, g_new, gd_new, &ev_k, &t_ev, x_ev, &from, ctx[CX_TLAST_STEP],
+                            8.0 * atol, 8.0 * rtol))) {
             status = st;
             break;
         }
@@ -102,10 +116,51 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             ctx[CX_GRID_K] = (double)k1;
         }
         h_abs = h_try;
+        ++isteps_call;
+        ctx[CX_ISTEPS] += 1;
+        ctx[CX_ISTEPS_EV] += 1;
         if (ev_k < 0) {
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }
-            for (int k = 0; k < ntr; ++k) { g_old[k] = g_new[k]; gd_old[k] = gd_new[k]; }
+            for (int k = 0; k < nsf; ++k) { g_old[k] = g_new[k]; gd_old[k] = gd_new[k]; }
+            if (nsf > ntr && (zs = approaching_slide(mode, t, s.y_old, p, s.n, g_old, gd_old, h_abs,
+                                                           20.0 * (atol + rtol))) >= 0) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old);
+                ctx[CX_INFO] = MODE_SW0[mode] + (zs - ntr);
+                status = ST_SLIDING;
+                break;
+            }
+            continue;
+        }
+        if (ev_k >= ntr) {
+            /* --- a switching surface: restart the integrator on its far side, or stop if the flow
+             * there points back into it (sliding) --- */
+            if (recording && sample_dt <= 0.0) put_row(&rec, t_ev, mode, s.n, x_ev);
+            /* crossings accumulating (a switch chattering about a kink) count towards Zeno */
+            if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
+            ctx[CX_TPREV_EVENT] = t_ev;
+            t = t_ev;
+            for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
+            if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
+            surfaces(mode, t, s.y_old, p, g_old);
+            surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
+            if (slides_after_crossing(mode, ev_k, t, s.y_old, p, s.n, g_old[ev_k], gd_old[ev_k], from)) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old); /* where it ends */
+                ctx[CX_INFO] = MODE_SW0[mode] + (ev_k - ntr);
+                status = ST_SLIDING;
+                break;
+            }
+            if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, ev_k)) >= 0) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old);
+                ctx[CX_INFO] = MODE_SW0[mode] + (zs - ntr);
+                status = ST_SLIDING;
+                break;
+            }
+            if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) {
+                if (recording && sample_dt > 0.0) put_row(&rec, t, mode, s.n, s.y_old);
+                status = ST_ZENO;
+                break;
+            }
             continue;
         }
         /* --- an event: record, then terminate or reset --- */
@@ -127,6 +182,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         }
         if (ev_recording) put_event(&rec, t_ev, tr, s.n, x_ev, MODE_NX[target], xpost);
         ctx[CX_EVENTS] += 1;
+        ctx[CX_ISTEPS_EV] = 0;
         if (TR_TERMINAL[tr]) {
             t = t_ev;
             for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
@@ -136,6 +192,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         }
         if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
         ctx[CX_TPREV_EVENT] = t_ev;
+        const int fired = target == mode ? ev_k : -1;
         mode = target;
         s.n = MODE_NX[mode];
         t = t_ev;
@@ -143,8 +200,14 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (recording) put_row(&rec, t, mode, s.n, s.y_old);
         if (TR_STEP[tr]) { ctx[CX_STEPS] += 1; ctx[CX_TLAST_STEP] = t_ev; }
         if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
-        guards(mode, t, s.y_old, p, g_old);
-        guards_dot(mode, t, s.y_old, s.f_old, p, gd_old);
+        surfaces(mode, t, s.y_old, p, g_old);
+        surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
+        arm_zero_guards(mode, g_old, gd_old, fired);
+        if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
+            ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
+            status = ST_SLIDING;
+            break;
+        }
         if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) { status = ST_ZENO; break; }
         if (max_steps > 0 && ctx[CX_STEPS] >= max_steps) { status = ST_STEPS_DONE; break; }
         if (max_events > 0 && ctx[CX_EVENTS] >= max_events) { status = ST_MAX_EVENTS; break; }
