@@ -17,6 +17,8 @@ from ..errors import AmbleError
 from ..simulation.engine import Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 
+MODEL_HELP = ("a library model (see 'amble models') or a model file path/to/file.py[:callable]: the callable, "
+              "else the file's build(), else the one HybridSystem it defines")
 
 # ---------------------------------------------------------------------- commands
 def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
@@ -212,7 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     def model_args(sp: argparse.ArgumentParser, tol: float | None) -> None:
         """``tol=None``: the tolerances default to the API's default of the chosen kind."""
-        sp.add_argument("model", help="model name (see 'amble models')")
+        sp.add_argument("model", help=MODEL_HELP)
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
         said = (f"{tol:g}" if tol is not None else
                 "the kind's: " + ", ".join(f"{kind} {v:g}" for kind, v in SWEEP_TOL.items()))
@@ -221,7 +223,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     add("models", "list the model library").set_defaults(func=cmd_models)
     e = add("equations", "show the derived equations of motion and transitions of a model")
-    e.add_argument("model", help="model name (see 'amble models')")
+    e.add_argument("model", help=MODEL_HELP)
     e.add_argument("--latex", action="store_true", help="LaTeX instead of plain text")
     e.set_defaults(func=cmd_equations)
     s = add("simulate", "simulate a model for N steps or T seconds")
