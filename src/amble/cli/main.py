@@ -56,6 +56,10 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     out_p = writable_path(args.out, (".csv", ".parquet", ".npz"), "--out")
     plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    if anim_p:  # an MP4 without ffmpeg is refused before any work
+        from ..viz.movie import check_writer
+
+        check_writer(anim_p)
     if args.steps is not None and args.steps < 1:
         raise UsageError(f"--steps must be at least 1, got {args.steps}")
     if args.time is not None and not args.time > 0:
@@ -96,6 +100,10 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
 
     plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    if anim_p:  # an MP4 without ffmpeg is refused before any work
+        from ..viz.movie import check_writer
+
+        check_writer(anim_p)
     if args.period < 1:
         raise UsageError(f"--period must be at least 1, got {args.period}")
     s = load_model(args.model)
