@@ -22,6 +22,15 @@ MODEL_HELP = ("a library model (see 'amble models') or a model file path/to/file
               "else the file's build(), else the one HybridSystem it defines")
 
 # ---------------------------------------------------------------------- commands
+def _plain(doc: str | None) -> str:
+    """The first line of a docstring without reStructuredText markup (````w```` → ``w``, roles)."""
+    import re
+
+    line = (doc or "").strip().splitlines()[0] if (doc or "").strip() else ""
+    line = re.sub(r":[a-z]+:`~?([^`]*)`", r"\1", line)
+    return re.sub(r"``([^`]*)``", r"\1", line)
+
+
 def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
     from ..models import load, names
 
@@ -30,10 +39,12 @@ def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
         s = load(name)
         first = s.mode_names[0]
         rows.append({"name": name, "dims": s.dims, "modes": s.mode_names, "state_names": s.state_names(first),
-                     "parameters": s.parameters, "summary": (s.doc or "").strip().splitlines()[0] if s.doc else ""})
+                     "parameters": s.parameters, "summary": _plain(s.doc)})
     if not args.json:
         for r in rows:
-            print(f"{r['name']:<16} {r['dims']}D  {len(r['state_names']) // 2} coordinates  {r['summary']}")
+            n = len(r["state_names"]) // 2
+            count = f"{n} coordinate{'' if n == 1 else 's'}"
+            print(f"{r['name']:<16} {r['dims']}D  {count:<14} {r['summary']}")
     return {"models": rows}
 
 
@@ -150,7 +161,7 @@ EXAMPLES = {
     "equations": "amble equations compass-gait --latex",
     "simulate": "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html",
     "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
-    "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot bifurcation.png",
+    "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
 }
 
 
