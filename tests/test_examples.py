@@ -24,7 +24,8 @@ def run_example(name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> d
 
 
 def test_every_example_is_tested():
-    tested = {"walk_compass_gait.py", "limit_cycle.py", "custom_model.py", "equations_latex.py", "tutorial.ipynb"}
+    tested = {"walk_compass_gait.py", "limit_cycle.py", "custom_model.py", "equations_latex.py", "tutorial.ipynb",
+              "my_walker.py"}
     present = {p.name for p in EXAMPLES.iterdir() if p.suffix in (".py", ".ipynb")}
     assert present == tested
 
@@ -105,3 +106,8 @@ def test_tutorial_notebook_executes_headless(tmp_path):
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
     assert not [o for o in outputs if o.output_type == "error"]
     assert (tmp_path / "tutorial_walk.html").stat().st_size > 10_000
+
+
+def test_my_walker_runs_as_a_script(tmp_path, monkeypatch, capsys):
+    run_example("my_walker.py", tmp_path, monkeypatch)
+    assert capsys.readouterr().out.startswith("completed: 10 steps")

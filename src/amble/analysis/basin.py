@@ -30,9 +30,18 @@ from .sweep_runner import compiled, point_key, run_sweep
 
 #: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
 BASIN_LABELS = ("converged", "fell", "not converged", "failed")
-#: Columns of a basin result file and their types (:data:`amble.analysis.store.COLUMN_TYPES`).
-BASIN_COLUMNS = {"i": "int", "j": "int", "a": "float", "b": "float", "outcome": "str", "reason": "str", "steps": "int",
-                 "distance": "float"}
+#: Columns of a basin result file besides the two axis columns, which are named after the chosen
+#: coordinates (e.g. ``i, j, stance, stance_dot, outcome, ...``), and their types
+#: (:data:`amble.analysis.store.COLUMN_TYPES`). A file of another pair of coordinates, or of the
+#: older format whose axis columns were ``a, b``, has other columns and is refused on resume.
+BASIN_COLUMNS = {"i": "int", "j": "int", "outcome": "str", "reason": "str", "steps": "int", "distance": "float"}
+
+
+def basin_columns(x_names: Sequence[str]) -> dict[str, str]:
+    """The columns of a basin over coordinates ``x_names``, in file order."""
+    cols = {"i": "int", "j": "int", x_names[0]: "float", x_names[1]: "float"}
+    cols.update({k: v for k, v in BASIN_COLUMNS.items() if k not in ("i", "j")})
+    return cols
 
 
 @dataclass
@@ -84,7 +93,7 @@ class SetCoordinates:
 
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
                 base: list[float], fixed: list[float], to_state: Callable, steps: int, check_every: int, tol: float,
-                rtol: float, atol: float) -> list[dict[str, Any]]:
+                rtol: float, atol: float, x_names: Sequence[str]) -> list[dict[str, Any]]:
     """One or more grid rows: walk each cell with the compiled run loop, no recording."""
     k = build(system)
     mi = 0
@@ -115,7 +124,7 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
                         break
                 if not reason:
                     code = 0 if dist < tol else 2
-            out.append({"i": i, "j": j, "a": float(a), "b": float(b), "outcome": BASIN_LABELS[code],
+            out.append({"i": i, "j": j, x_names[0]: float(a), x_names[1]: float(b), "outcome": BASIN_LABELS[code],
                         "reason": reason, "steps": done, "distance": dist})
     return out
 
@@ -159,6 +168,8 @@ def basin(
     for nm in x_names:
         if nm not in snames:
             raise StateError(f"unknown coordinate {nm!r}; known: {', '.join(snames)}")
+    if len(set(x_names)) != 2:
+        raise StateError(f"basin: two different coordinates are needed, got {', '.join(x_names)}")
     if len(n) != 2 or min(n) < 1 or steps < 1 or check_every < 1 or rows_per_task < 1:
         raise StateError("need n = (na ≥ 1, nb ≥ 1), steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
     av = np.linspace(ranges[0][0], ranges[0][1], int(n[0]))
@@ -176,9 +187,9 @@ def basin(
 
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
-                to_state, steps, check_every, tol, rtol, atol)
+                to_state, steps, check_every, tol, rtol, atol, list(x_names))
 
-    res = run_sweep(kind="basin", columns=BASIN_COLUMNS, key=["i", "j", "a", "b"], keys=keys,
+    res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
                     groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,
                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
                     params=list(x_names), state_names=snames)
@@ -201,4 +212,4 @@ def basin(
                        state_names=snames, reasons=why)
 
 
-__all__ = ["BASIN_LABELS", "BasinResult", "SetCoordinates", "basin"]
+__all__ = ["BASIN_COLUMNS", "BASIN_LABELS", "BasinResult", "SetCoordinates", "basin", "basin_columns"]

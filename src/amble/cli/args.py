@@ -87,6 +87,7 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
 
 
 def load_model(name: str):
-    from ..models import load
+    """A library model by name, or the system of a model file ``path/to/file.py[:callable]``."""
+    from ..models import is_file_spec, load, load_file
 
-    return load(name)
+    return load_file(name) if is_file_spec(name) else load(name)

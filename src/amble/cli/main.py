@@ -16,9 +16,21 @@ from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError
 from ..simulation.engine import Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
+from .equations import cmd_equations
 
+MODEL_HELP = ("a library model (see 'amble models') or a model file path/to/file.py[:callable]: the callable, "
+              "else the file's build(), else the one HybridSystem it defines")
 
 # ---------------------------------------------------------------------- commands
+def _plain(doc: str | None) -> str:
+    """The first line of a docstring without reStructuredText markup (````w```` → ``w``, roles)."""
+    import re
+
+    line = (doc or "").strip().splitlines()[0] if (doc or "").strip() else ""
+    line = re.sub(r":[a-z]+:`~?([^`]*)`", r"\1", line)
+    return re.sub(r"``([^`]*)``", r"\1", line)
+
+
 def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
     from ..models import load, names
 
@@ -27,65 +39,13 @@ def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
         s = load(name)
         first = s.mode_names[0]
         rows.append({"name": name, "dims": s.dims, "modes": s.mode_names, "state_names": s.state_names(first),
-                     "parameters": s.parameters, "summary": (s.doc or "").strip().splitlines()[0] if s.doc else ""})
+                     "parameters": s.parameters, "summary": _plain(s.doc)})
     if not args.json:
         for r in rows:
-            print(f"{r['name']:<16} {r['dims']}D  {len(r['state_names']) // 2} coordinates  {r['summary']}")
+            n = len(r["state_names"]) // 2
+            count = f"{n} coordinate{'' if n == 1 else 's'}"
+            print(f"{r['name']:<16} {r['dims']}D  {count:<14} {r['summary']}")
     return {"models": rows}
-
-
-def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
-    import sympy as sp
-
-    from ..derivation.equations import derive
-
-    s = load_model(args.model)
-    out: dict[str, Any] = {"model": args.model, "modes": {}}
-    for mname, m in s.modes.items():
-        eq = derive(m)
-        g = m.gravity_vector
-        entry = {
-            "coordinates": [str(q) for q in m.q],
-            "velocities": [str(v) for v in m.qd],
-            "parameters": {str(k): v for k, v in m.params.items()},
-            "mass_matrix": [[_show(eq.M[i, j]) for j in range(eq.M.cols)] for i in range(eq.M.rows)],
-            "bias": [_show(e) for e in eq.h],
-            "generalized_force": [sp.sstr(e) for e in eq.Gamma],
-            "gravity_vector": [sp.sstr(e) for e in g],
-            "operation_count": eq.count_ops(),
-        }
-        if args.latex:
-            entry["latex"] = eq.latex()
-        out["modes"][mname] = entry
-    first = next(iter(out["modes"].values()))
-    out.update({k: first[k] for k in ("coordinates", "parameters", "mass_matrix", "bias", "gravity_vector")})
-    out["transitions"] = [{"name": tr.name, "source": tr.source, "target": tr.target,
-                           "reset": type(tr.reset).__name__ if tr.reset else None, "terminal": tr.terminal,
-                           "guard": sp.sstr(tr.guard.expr)} for tr in s.transitions]
-    if not args.json:
-        for mname, e in out["modes"].items():
-            print(f"mode {mname}: q = ({', '.join(e['coordinates'])})")
-            if args.latex:
-                print(e["latex"])
-            else:
-                for i, row in enumerate(e["mass_matrix"]):
-                    print(f"  M[{i}] = [{', '.join(row)}]")
-                for i, b in enumerate(e["bias"]):
-                    print(f"  h[{i}] = {b}")
-            print(f"  operations (shared subexpressions): {e['operation_count']}")
-        for tr in out["transitions"]:
-            print(f"transition {tr['name']}: {tr['source']} -> {tr['target']} ({tr['reset'] or tr['terminal']})")
-    return out
-
-
-def _show(expr: Any) -> str:
-    """A readable string of an entry: small ones are tidied with trigsimp (the compiled code
-    never is — derivation keeps expressions unexpanded), large ones are printed as derived."""
-    import sympy as sp
-
-    if sp.count_ops(expr) <= 150:
-        expr = sp.trigsimp(expr)
-    return sp.sstr(expr)
 
 
 def _start(s, text: str | None, params: dict[str, float]):
@@ -107,6 +67,10 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     out_p = writable_path(args.out, (".csv", ".parquet", ".npz"), "--out")
     plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    if anim_p:  # an MP4 without ffmpeg is refused before any work
+        from ..viz.movie import check_writer
+
+        check_writer(anim_p)
     if args.steps is not None and args.steps < 1:
         raise UsageError(f"--steps must be at least 1, got {args.steps}")
     if args.time is not None and not args.time > 0:
@@ -147,6 +111,10 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
 
     plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    if anim_p:  # an MP4 without ffmpeg is refused before any work
+        from ..viz.movie import check_writer
+
+        check_writer(anim_p)
     if args.period < 1:
         raise UsageError(f"--period must be at least 1, got {args.period}")
     s = load_model(args.model)
@@ -193,7 +161,7 @@ EXAMPLES = {
     "equations": "amble equations compass-gait --latex",
     "simulate": "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html",
     "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
-    "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot bifurcation.png",
+    "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
 }
 
 
@@ -212,7 +180,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     def model_args(sp: argparse.ArgumentParser, tol: float | None) -> None:
         """``tol=None``: the tolerances default to the API's default of the chosen kind."""
-        sp.add_argument("model", help="model name (see 'amble models')")
+        sp.add_argument("model", help=MODEL_HELP)
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
         said = (f"{tol:g}" if tol is not None else
                 "the kind's: " + ", ".join(f"{kind} {v:g}" for kind, v in SWEEP_TOL.items()))
@@ -220,9 +188,11 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--atol", type=float, default=tol, help=f"absolute tolerance (default {said})")
 
     add("models", "list the model library").set_defaults(func=cmd_models)
-    e = add("equations", "show the derived equations of motion and transitions of a model")
-    e.add_argument("model", help="model name (see 'amble models')")
-    e.add_argument("--latex", action="store_true", help="LaTeX instead of plain text")
+    e = add("equations", "show the derived equations of motion, and the guards and derived impact and lock maps "
+                        "of the transitions")
+    e.add_argument("model", help=MODEL_HELP)
+    e.add_argument("--latex", action="store_true",
+                   help="LaTeX instead of plain text (with --json: LaTeX fields beside the plain ones)")
     e.set_defaults(func=cmd_equations)
     s = add("simulate", "simulate a model for N steps or T seconds")
     model_args(s, Options().rtol)

@@ -10,6 +10,7 @@ short report (or returns it for ``--json``) and draws the plot. Bad input raises
 from __future__ import annotations
 
 import math
+import sys
 import time
 from typing import Any
 
@@ -61,6 +62,9 @@ def sweep_cli(args: Any) -> dict[str, Any]:
     res = (_run_basin(system, ranges, args, common, summary) if basin_kind
            else _run_parameters(system, ranges, args, common, summary))
     summary["seconds"] = round(time.perf_counter() - t0, 3)
+    if common["progress"] and not sys.stderr.isatty():
+        # a bar written to a pipe or file ends with a carriage return, not a newline: end its line
+        print(file=sys.stderr, flush=True)
     if plot is not None:
         from ..viz import sweep_plots as sp
 

@@ -70,14 +70,14 @@ class Equations:
         return count_ops_cse([*self.M, *self.h, *self.Gamma])
 
     def latex(self, display: bool = False) -> str:
-        """LaTeX of ``M(q) q̈ + h(q, q̇) = Γ`` with the matrices written out."""
-        names = {s: sp.Symbol(_latex_name(str(s))) for s in self.q}
-        names.update({v: sp.Symbol(r"\dot{" + _latex_name(str(s)) + "}") for s, v in zip(self.q, self.qd)})
-        names.update({a: sp.Symbol(r"\ddot{" + _latex_name(str(s)) + "}") for s, a in zip(self.q, self.qdd)})
-        m = sp.latex(self.M.subs(names))
+        """LaTeX of ``M(q) q̈ + h(q, q̇) = Γ`` with the matrices written out, entries tidied as
+        :func:`tidy` does for the plain-text display and names typeset by :func:`latex_names`."""
+        names = latex_names(self.model)
+        names.update({a: sp.Symbol(_typeset(str(s), self.model, "ddot")) for s, a in zip(self.q, self.qdd)})
+        m = latex_matrix(self.M, names)
         qdd = sp.latex(sp.Matrix(self.qdd).subs(names))
-        h = sp.latex(self.h.subs(names))
-        g = sp.latex(self.Gamma.subs(names))
+        h = latex_matrix(self.h, names)
+        g = latex_matrix(self.Gamma, names)
         body = f"{m}\\,{qdd} + {h} = {g}"
         return f"$${body}$$" if display else body
 
@@ -86,11 +86,63 @@ class Equations:
         return self.latex(display=True)
 
 
-def _latex_name(name: str) -> str:
-    greek = {"theta", "phi", "psi", "alpha", "beta", "gamma", "tau", "omega"}
+TIDY_OPS = 150  # entries up to this many operations are tidied for display (trigsimp)
+
+
+def tidy(expr: sp.Expr) -> sp.Expr:
+    """An entry as displayed: small ones tidied with ``trigsimp`` (``sin² + cos²`` → 1), large ones
+    as derived. Display only — the compiled code is generated from the unexpanded expressions."""
+    expr = sp.sympify(expr)
+    return sp.trigsimp(expr) if sp.count_ops(expr) <= TIDY_OPS else expr
+
+
+def latex_matrix(matrix: sp.Matrix, names: dict) -> str:
+    """LaTeX of a matrix with every entry tidied (:func:`tidy`) and its symbols renamed."""
+    return sp.latex(matrix.applyfunc(tidy).subs(names))
+
+
+_GREEK = {"alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa", "lambda",
+          "mu", "nu", "xi", "pi", "rho", "sigma", "tau", "upsilon", "phi", "chi", "psi", "omega",
+          "Gamma", "Delta", "Theta", "Lambda", "Xi", "Pi", "Sigma", "Upsilon", "Phi", "Psi", "Omega"}
+_ANGLE_UNITS = {"", "rad", "deg", "°"}
+
+
+def latex_names(model: Model) -> dict[sp.Symbol, sp.Symbol]:
+    """Typeset names of a model's coordinates, velocities and parameters, as symbols to substitute.
+
+    A name is split at its first ``_`` into a base and a subscript. A base that names a Greek letter
+    is that letter (``theta_1`` → ``\\theta_{1}``), a one-letter base stays (``x_stance`` →
+    ``x_{\\mathrm{stance}}``). A coordinate with a longer base becomes ``\\theta`` (angle or no
+    declared unit) or ``q`` (another unit) subscripted with its whole name: ``stance`` →
+    ``\\theta_{\\mathrm{stance}}``, its velocity ``\\dot{\\theta}_{\\mathrm{stance}}``. A parameter
+    with a longer base is set upright: ``slope`` → ``\\mathrm{slope}``."""
+    out: dict[sp.Symbol, sp.Symbol] = {}
+    for s, v in zip(model.q, model.qd):
+        out[s] = sp.Symbol(_typeset(str(s), model, ""))
+        out[v] = sp.Symbol(_typeset(str(s), model, "dot"))
+    for p in model.params:
+        out[p] = sp.Symbol(_typeset(str(p), None, ""))
+    return out
+
+
+def _sub(text: str) -> str:
+    return text if len(text) == 1 or text.isdigit() else r"\mathrm{" + text.replace("_", r"\_") + "}"
+
+
+def _typeset(name: str, model: Model | None, accent: str) -> str:
     base, _, sub = name.partition("_")
-    base_tex = "\\" + base if base in greek else base
-    return f"{base_tex}_{{{sub}}}" if sub else base_tex
+    if not sub and len(base) > 1 and base[0].isalpha() and base[1:].isdigit():  # a1 → a_{1}
+        base, sub = base[0], base[1:]
+    if base in _GREEK or len(base) == 1:
+        head = ("\\" + base) if base in _GREEK else base
+    elif model is not None:  # a coordinate: a letter with the whole name as subscript
+        head = r"\theta" if model.unit(name) in _ANGLE_UNITS else "q"
+        sub = name
+    else:
+        return _sub(name)
+    if accent:
+        head = f"\\{accent}{{{head}}}"
+    return f"{head}_{{{_sub(sub)}}}" if sub else head
 
 
 def derive(model: Model) -> Equations:

@@ -171,8 +171,10 @@ class Trajectory:
     def save(self, path: str | Path) -> Path:
         """Write the samples to ``.csv``, ``.parquet`` or ``.npz`` (chosen by suffix).
 
-        Units travel with the columns: CSV headers read ``name [unit]``, Parquet fields carry a
-        ``unit`` metadata entry, an ``.npz`` holds ``units`` (one per column, in order)."""
+        A CSV ends with an ``event`` column: ``NAME:pre`` and ``NAME:post`` on the two rows of
+        transition ``NAME``. Units travel with the columns: CSV headers read ``name [unit]``,
+        Parquet fields carry a ``unit`` metadata entry, an ``.npz`` holds ``units`` (one
+        per column, in order)."""
         path = Path(path)
         cols = self.table()
         units = [self.unit(c) for c in cols]
@@ -188,9 +190,9 @@ class Trajectory:
 
             with path.open("w", newline="") as f:
                 wr = csv.writer(f)
-                wr.writerow([f"{c} [{u}]" if u else c for c, u in zip(cols, units)])
-                for row in zip(*cols.values()):
-                    wr.writerow([v if isinstance(v, str) else repr(float(v)) for v in row])
+                wr.writerow([f"{c} [{u}]" if u else c for c, u in zip(cols, units)] + ["event"])
+                for row, mark in zip(zip(*cols.values()), self._event_marks()):
+                    wr.writerow([v if isinstance(v, str) else repr(float(v)) for v in row] + [mark])
         elif suffix == ".parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq
@@ -201,6 +203,23 @@ class Trajectory:
         else:
             raise AmbleError(f"unknown output format {path.suffix!r}: use .csv, .parquet or .npz")
         return path
+
+    def _event_marks(self) -> list[str]:
+        """The CSV ``event`` column: ``NAME:pre`` on the row just before transition ``NAME``,
+        ``NAME:post`` on the row just after it (same time), empty elsewhere."""
+        marks = [""] * len(self.t)
+        i = 0
+        for ev in self.events:
+            while i < len(self.t) and self.t[i] < ev.t:
+                i += 1
+            if i >= len(self.t):
+                break
+            marks[i] = f"{ev.name}:pre"
+            if i + 1 < len(self.t) and self.t[i + 1] == ev.t:
+                marks[i + 1] = f"{ev.name}:post"
+                i += 1
+            i += 1
+        return marks
 
     def summary(self) -> dict[str, Any]:
         """JSON-friendly summary of the run (the CLI's ``--json`` output)."""

@@ -12,20 +12,20 @@ import numpy as np
 from ..modelling.hybrid import HybridSystem
 from ..modelling.walker import Walker
 from ..simulation.trajectory import Trajectory
-from .errors import ExportError, SceneError, VizError
-from .scene import Cylinder, Ground, Shape, Sphere, default_look, frames
+from .errors import SceneError, VizError
+from .scene import Ground, Shape, Sphere, default_look, frames
 
 
 def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] | None = None) -> list[Any]:
-    """The shapes that draw a system: ``look`` if given (with the walker's ground added), else a
-    default from its masses, links and slope."""
-    slope = _slope(system, params)
+    """The shapes that draw a system: ``look`` if given (with a walker's ground added), else a
+    default from its masses and links (and a walker's slope). Only a :class:`Walker` has a ground."""
+    slope = _slope(system, params) if isinstance(system, Walker) else None
     if look:
         shapes = list(look)
         for s in shapes:
             if not isinstance(s, Shape):
                 raise SceneError(f"look: not a shape (Sphere, Cylinder, Box or Ground): {s!r}")
-        if not any(isinstance(s, Ground) for s in shapes):
+        if slope is not None and not any(isinstance(s, Ground) for s in shapes):
             shapes.insert(0, Ground(slope=slope))
         return shapes
     masses: dict[str, float] = {}
@@ -55,18 +55,25 @@ def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = N
     system = traj.system
     times, pts = traj.resample(fps)
     shapes = look_of(system, traj.parameters, look)
-    step_idx = np.searchsorted([e.t for e in traj.step_events], times, side="right")
-    hip = system.hip if isinstance(system, Walker) else None
+    walker = isinstance(system, Walker)
+    hip = system.hip if walker else None
     follow = hip if hip in pts else None
     used = {n for s in shapes for n in s.points()}
     pts = {n: np.nan_to_num(v) for n, v in pts.items() if n in used or n == follow}
-    return frames(shapes, pts, times, follow=follow, labels={"step": step_idx.tolist()})
+    labels = {}
+    if walker:  # a step count means something for a walker only
+        labels["step"] = np.searchsorted([e.t for e in traj.step_events], times, side="right").tolist()
+    return frames(shapes, pts, times, follow=follow, labels=labels)
 
 
-def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None) -> Path:
+def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None,
+            progress: bool | None = None) -> Path:
     """Write an animation of ``traj``: ``.html`` (3D, offline, interactive), ``.gif`` or ``.mp4``.
 
-    ``look``: the shapes to draw (:mod:`amble.viz.scene`); default: made from the model."""
+    ``look``: the shapes to draw (:mod:`amble.viz.scene`); default: made from the model. A movie
+    plays in the trajectory's time with a clock, at most 30 fps (a GIF at a rate whose frames last
+    whole hundredths of a second: 25 fps for 30); ``progress``: a progress bar while a movie is
+    written (default: when stderr is a terminal). See :mod:`amble.viz.movie`."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".html":
@@ -74,60 +81,10 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
 
         return write_html(path, scene_of(traj, fps, look), title=f"amble — {traj.system.name}")
     if suffix in (".gif", ".mp4"):
-        return _movie(traj, path, fps=min(fps, 30.0), look=look)
+        from .movie import check_writer, write_movie
+
+        check_writer(path)
+        system = traj.system
+        slope = _slope(system, traj.parameters) if isinstance(system, Walker) else None
+        return write_movie(traj, path, fps, look_of(system, traj.parameters, look), slope, progress=progress)
     raise VizError(f"unknown animation format {path.suffix!r}: use .html, .gif or .mp4")
-
-
-def _movie(traj: Trajectory, path: Path, fps: float, look: Sequence[Any] | None) -> Path:
-    """Side view (x–z) for 2D models; side and front views for 3D ones."""
-    system = traj.system
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.animation import FuncAnimation, PillowWriter
-
-    times, pts = traj.resample(fps)
-    shapes = look_of(system, traj.parameters, look)
-    links = [s for s in shapes if isinstance(s, Cylinder)]
-    balls = [s for s in shapes if isinstance(s, Sphere)]
-    views = [(0, 2, "side (x–z)")] + ([(1, 2, "front (y–z)")] if system.dims == 3 else [])
-    fig, axes = plt.subplots(1, len(views), figsize=(5 * len(views), 4), squeeze=False)
-    allp = np.concatenate([np.nan_to_num(v) for v in pts.values()])
-    slope = _slope(system, traj.parameters)
-    artists = []
-    for ax, (i, j, title) in zip(axes[0], views):
-        ax.set_aspect("equal")
-        ax.set_title(title)
-        lo, hi = allp.min(axis=0) - 0.3, allp.max(axis=0) + 0.3
-        ax.set_xlim(lo[i], hi[i])
-        ax.set_ylim(min(lo[j], -np.tan(slope) * hi[0]) - 0.1, hi[j])
-        if i == 0:
-            xs = np.array([lo[0], hi[0]])
-            ax.plot(xs, -np.tan(slope) * xs, color="0.5")
-        lines = [ax.plot([], [], "-", color="0.4", lw=2)[0] for _ in links]
-        dots = [ax.plot([], [], "o", color=s.color, ms=4 + 60 * s.radius)[0] for s in balls]
-        artists.append((i, j, lines, dots))
-
-    def draw(f: int):
-        out = []
-        for i, j, lines, dots in artists:
-            for ln, s in zip(lines, links):
-                a, b = pts[s.between[0]][f], pts[s.between[1]][f]
-                ln.set_data([a[i], b[i]], [a[j], b[j]])
-                out.append(ln)
-            for d, s in zip(dots, balls):
-                d.set_data([pts[s.at][f][i]], [pts[s.at][f][j]])
-                out.append(d)
-        return out
-
-    anim = FuncAnimation(fig, draw, frames=len(times), interval=1000 / fps, blit=True)
-    if path.suffix.lower() == ".gif":
-        anim.save(path, writer=PillowWriter(fps=fps))
-    else:
-        try:
-            anim.save(path, fps=fps)
-        except (ValueError, RuntimeError, FileNotFoundError) as e:
-            raise ExportError(f"cannot write {path.name}: MP4 needs ffmpeg ({e}); use .gif or .html") from None
-    plt.close(fig)
-    return path
