@@ -35,6 +35,8 @@ class _Printer(C99CodePrinter):
         name = self._names.get(expr)
         return name if name is not None else super()._print_Symbol(expr)
 
+    _print_Dummy = _print_Symbol
+
     def _print_Pow(self, expr: sp.Pow) -> str:
         base, e = expr.base, expr.exp
         if e.is_Integer and 2 <= int(e) <= 4:
@@ -64,13 +66,16 @@ def _names(model: Model, params: list[str]) -> dict[sp.Symbol, str]:
     return names
 
 
-def _block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ") -> str:
-    """C statements assigning ``exprs`` to ``targets`` with shared subexpressions."""
+def _block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ",
+           prelude: str = "") -> str:
+    """C statements assigning ``exprs`` to ``targets`` with shared subexpressions (after
+    ``prelude``, the statements of named intermediate quantities the expressions may use)."""
     if not exprs:
         return ""
     repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
     pr = _Printer(names)
-    lines = [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
+    lines = [prelude] if prelude else []
+    lines += [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
     lines += [f"{indent}{tgt} = {pr.doprint(e)};" for tgt, e in zip(targets, reduced)]
     return "\n".join(lines) + "\n"
 
@@ -112,24 +117,29 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         m, eq, k = mi.model, mi.equations, mi.index
         n = len(m.q)
         nm = _names(m, params)
+        # a rigid-body tree's M and h come with their intermediate quantities (Equations.compact)
+        defs, eqM, eqh = eq.compact if eq.compact is not None else ((), eq.M, eq.h)
+        nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
+        pr = _Printer(nm)
+        prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
         # right-hand side: q̈ = M⁻¹ (Γ − h)
         tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)]
-        ex = [eq.M[i, j] for i in range(n) for j in range(i + 1)]
+        ex = [eqM[i, j] for i in range(n) for j in range(i + 1)]
         tg += [f"f[{i}]" for i in range(n)]
-        ex += [eq.Gamma[i] - eq.h[i] for i in range(n)]
+        ex += [eq.Gamma[i] - eqh[i] for i in range(n)]
         w(f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n")
         w(f"    double M[{n * n}], f[{n}];\n    (void)t; (void)p;\n")
-        w(_block(tg, ex, nm))
+        w(_block(tg, ex, nm, prelude=prelude))
         w(f"    int err = amble_chol_solve({n}, M, f);\n")
         w(f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n")
         w("    return err;\n}\n")
         # M, h and Γ separately (analysis and display; the integrator uses rhs above)
         tg = [f"M[{i * n + j}]" for i in range(n) for j in range(n)] + [f"h[{i}]" for i in range(n)]
         tg += [f"G[{i}]" for i in range(n)]
-        ex = [eq.M[i, j] for i in range(n) for j in range(n)] + list(eq.h) + list(eq.Gamma)
+        ex = [eqM[i, j] for i in range(n) for j in range(n)] + list(eqh) + list(eq.Gamma)
         w(f"static void dynamics_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n")
         w("    (void)t; (void)p;\n")
-        w(_block(tg, ex, nm))
+        w(_block(tg, ex, nm, prelude=prelude))
         w("}\n")
         # guards of this mode's transitions
         trs = trs_by_mode[name]

@@ -26,6 +26,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .geometry import t, vector
+from .tree import RigidTree
 
 
 class Model:
@@ -67,6 +68,8 @@ class Model:
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
+        #: the rigid-body tree, if bodies and joints were declared (:meth:`rigid_tree`)
+        self.tree: RigidTree | None = None
 
     # ------------------------------------------------------------------ symbols
     def coordinates(self, names: str | Sequence[str], unit: str = "rad") -> tuple[sp.Symbol, ...]:
@@ -133,8 +136,13 @@ class Model:
             raise ModelError(f"model {self.name!r}: {coordinate} is not a coordinate") from None
 
     def dt(self, expr: Any) -> Any:
-        """Total time derivative of an expression (or vector) of q and t, by the chain rule."""
+        """Total time derivative of an expression (or vector) of q and t, by the chain rule
+        (the velocity of a point on a rigid-body tree comes from the tree, undifferentiated)."""
         if isinstance(expr, sp.MatrixBase):
+            if self.tree is not None:
+                for name, pos in self.points.items():
+                    if pos is expr and name in self.tree.point_velocities:
+                        return self.tree.point_velocities[name]
             return expr.applyfunc(self.dt)
         expr = sp.sympify(expr)
         out = sp.diff(expr, t)
@@ -183,6 +191,22 @@ class Model:
                 raise ModelError(f"model {self.name!r}: link to unknown point {p!r}")
         self.links.append((a, b))
 
+    def rigid_tree(self) -> RigidTree:
+        """The model's kinematic tree of rigid bodies and joints (created on first use; 3D only):
+        ``model.rigid_tree().body(...)`` — see :mod:`amble.modelling.tree`."""
+        if self.tree is None:
+            self.tree = RigidTree(self)
+        return self.tree
+
+    @classmethod
+    def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,
+                  name: str | None = None) -> Model:
+        """A model of the robot in a URDF file with ``base`` (a link name; default: the root)
+        fixed to the world — see :func:`amble.modelling.urdf.load_urdf`."""
+        from .urdf import build_model
+
+        return build_model(cls, path, base=base, contact_points=contact_points, name=name)
+
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
         self._k_terms.append(sp.Rational(1, 2) * sp.sympify(moment) * self.dt(angle) ** 2)
@@ -226,8 +250,10 @@ class Model:
         """Kinetic energy: Σ ½ mᵢ |ṗᵢ|² plus added terms, unless given outright."""
         if self._k_override is not None:
             return self._k_override
-        k = sp.Integer(0)
+        k = sp.Integer(0) if self.tree is None else self.tree.kinetic()
         for name, m in self.masses.items():
+            if self.tree is not None and name in self.tree.com_points:
+                continue
             v = self.dt(self.points[name])
             k += sp.Rational(1, 2) * m * (v.T * v)[0, 0]
         return k + sum(self._k_terms, sp.Integer(0))
@@ -243,7 +269,11 @@ class Model:
             return self._v_override
         v = sp.Integer(0)
         gvec = self.gravity_vector
+        if self.tree is not None:
+            v = self.tree.potential(gvec)
         for name, m in self.masses.items():
+            if self.tree is not None and name in self.tree.com_points:
+                continue
             v += -m * (gvec.T * self.points[name])[0, 0]
         return v + sum(self._v_terms, sp.Integer(0))
 
@@ -310,6 +340,9 @@ class Model:
         Positions, energies and masses are substituted; generalized forces are mapped by virtual
         work, ``Γ_new = (∂q/∂q_new)ᵀ Γ``, so a torque declared once acts correctly in both modes.
         """
+        if self.tree is not None:
+            raise ModelError(f"model {self.name!r}: constrained() of a rigid-body tree model is not "
+                             "supported; declare the locked joint as fixed in a second model")
         subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
         for k in subs:
             if k not in self.q:
@@ -361,7 +394,7 @@ class Model:
 
     def _check_symbols(self, expr: Any, what: str) -> None:
         allowed = set(self.q) | set(self.params) | {t}
-        free = sp.sympify(expr).free_symbols if not isinstance(expr, sp.MatrixBase) else expr.free_symbols
+        free = free_symbols(expr)
         bad = sorted(str(s) for s in free - allowed)
         if bad:
             raise ModelError(
@@ -385,15 +418,15 @@ class Model:
                 )
         allowed_kv = set(self.q) | set(self.qd) | set(self.params) | {t}
         for label, expr in (("K", self.K), ("V", self.V), ("L", self.L)):
-            bad = sorted(str(s) for s in expr.free_symbols - allowed_kv)
+            bad = sorted(str(s) for s in free_symbols(expr) - allowed_kv)
             if bad:
                 raise ModelError(
                     f"model {self.name!r}: {label} uses {', '.join(bad)}, which is neither a "
                     "coordinate, a velocity nor a parameter"
                 )
-        if any(s in self.V.free_symbols for s in self.qd):
+        if any(s in free_symbols(self.V) for s in self.qd):
             raise ModelError(f"model {self.name!r}: the potential energy V depends on velocities")
-        bad = sorted(str(s) for s in self.generalized_force.free_symbols - allowed_kv)
+        bad = sorted(str(s) for s in free_symbols(self.generalized_force) - allowed_kv)
         if bad:
             raise ModelError(f"model {self.name!r}: forces use unknown symbols {', '.join(bad)}")
 
@@ -402,3 +435,22 @@ class Model:
             f"Model({self.name!r}, dims={self.dims}, q=[{', '.join(map(str, self.q))}], "
             f"params=[{', '.join(self.parameter_names)}])"
         )
+
+
+def free_symbols(expr: Any) -> set[sp.Symbol]:
+    """Free symbols of an expression or matrix, visiting each shared subexpression once (the
+    expressions of a rigid-body tree are DAGs: a plain traversal would revisit shared parts)."""
+    roots = list(expr) if isinstance(expr, sp.MatrixBase) else [sp.sympify(expr)]
+    seen: set[int] = set()
+    out: set[sp.Symbol] = set()
+    stack = roots
+    while stack:
+        x = stack.pop()
+        if id(x) in seen:
+            continue
+        seen.add(id(x))
+        if x.is_Symbol:
+            out.add(x)
+        elif not x.is_Atom:
+            stack.extend(x.args)
+    return out
