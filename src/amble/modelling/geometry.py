@@ -37,3 +37,22 @@ def vector(*components: Any) -> sp.Matrix:
     if len(components) == 1 and isinstance(components[0], Iterable):
         components = tuple(components[0])
     return sp.Matrix([sp.sympify(c) for c in components])
+
+
+def free_symbols(expr: Any) -> set[sp.Symbol]:
+    """Free symbols of an expression or matrix, visiting each shared subexpression once (the
+    expressions of a rigid-body tree are DAGs: a plain traversal would revisit shared parts)."""
+    roots = list(expr) if isinstance(expr, sp.MatrixBase) else [sp.sympify(expr)]
+    seen: set[int] = set()
+    out: set[sp.Symbol] = set()
+    stack = roots
+    while stack:
+        x = stack.pop()
+        if id(x) in seen:
+            continue
+        seen.add(id(x))
+        if x.is_Symbol:
+            out.add(x)
+        elif not x.is_Atom:
+            stack.extend(x.args)
+    return out

@@ -25,7 +25,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
-from .geometry import t, vector
+from .geometry import free_symbols, t, vector
 from .tree import RigidTree
 
 
@@ -200,12 +200,14 @@ class Model:
 
     @classmethod
     def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,
-                  name: str | None = None) -> Model:
+                  name: str | None = None, allow_massless: bool = False, gravity: float = 9.81) -> Model:
         """A model of the robot in a URDF file with ``base`` (a link name; default: the root)
-        fixed to the world — see :func:`amble.modelling.urdf.load_urdf`."""
+        fixed to the world, named ``contact_points`` ``{name: (link, (x, y, z))}`` and gravity
+        ``gravity`` along −z — see :mod:`amble.modelling.urdf`."""
         from .urdf import build_model
 
-        return build_model(cls, path, base=base, contact_points=contact_points, name=name)
+        return build_model(cls, path, base=base, contact_points=contact_points, name=name,
+                           allow_massless=allow_massless, gravity=gravity)
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
@@ -436,21 +438,3 @@ class Model:
             f"params=[{', '.join(self.parameter_names)}])"
         )
 
-
-def free_symbols(expr: Any) -> set[sp.Symbol]:
-    """Free symbols of an expression or matrix, visiting each shared subexpression once (the
-    expressions of a rigid-body tree are DAGs: a plain traversal would revisit shared parts)."""
-    roots = list(expr) if isinstance(expr, sp.MatrixBase) else [sp.sympify(expr)]
-    seen: set[int] = set()
-    out: set[sp.Symbol] = set()
-    stack = roots
-    while stack:
-        x = stack.pop()
-        if id(x) in seen:
-            continue
-        seen.add(id(x))
-        if x.is_Symbol:
-            out.add(x)
-        elif not x.is_Atom:
-            stack.extend(x.args)
-    return out

@@ -248,7 +248,7 @@ class RigidTree:
             if parent not in self._by_name:
                 raise ModelError(f"model {m.name!r}: body {name!r} hangs from unknown body {parent!r}")
             par = self._by_name[parent]
-        mass_e = sp.sympify(mass)
+        mass_e = _num(mass) if isinstance(mass, (int, float)) else sp.sympify(mass)
         m._check_symbols(mass_e, f"mass of body {name!r}")
         b = Body(name=name, parent=par, joint=joint, mass=mass_e, com=_vec(com), inertia=_mat3(inertia))
         if b.com.shape != (3, 1):

@@ -115,6 +115,9 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
     if missing:
         raise ModelError(f"URDF {path.name}: links not connected to {base!r}: {', '.join(missing)}")
 
+    for lk in links.values():  # every inertial is checked, the base's too (nothing is silently dropped)
+        if lk.inertial is not None:
+            _check_inertial(lk)
     model = cls(name or robot.name or path.stem, dims=3)
     model.gravity(gravity)
     tree = model.rigid_tree()
