@@ -56,6 +56,8 @@ def rabbit() -> Urdf:
         u.link(f"{side}_tibia", 3.2, com=(0, 0, -0.24), inertia=box_inertia(3.2, 0.05, 0.05, 0.4))
         u.joint(f"{side}_hip", "torso", f"{side}_femur")
         u.joint(f"{side}_knee", f"{side}_femur", f"{side}_tibia", xyz=(0, 0, -0.4))
+        u.parts.append(f'  <link name="{side}_foot"/>')  # the tibia's tip: a frame, no mass
+        u.joint(f"{side}_ankle", f"{side}_tibia", f"{side}_foot", xyz=(0, 0, -0.4), kind="fixed")
     return u
 
 

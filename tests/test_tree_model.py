@@ -158,3 +158,35 @@ def test_tree_model_simulates_with_energy_conserved():
     e = k.energy_rows(np.zeros(2), np.zeros(2, dtype=np.int64), np.array([x0, traj.x[-1]]), np.zeros(1)).sum(axis=1)
     assert abs(traj.x[-1] - x0).max() > 0.1  # it swings
     assert abs(e[1] - e[0]) <= 1e-9 * abs(e[0])
+
+
+def test_urdf_walker_steps_with_a_derived_impact():
+    # RABBIT re-rooted at its left foot; the right foot strikes, legs swap (a derived plastic impact)
+    from amble import simulate, walker
+
+    # a point foot: the stance foot pivots about y on the ground (the coordinate "stance")
+    m = Model.from_urdf(Path(__file__).parent / "data" / "rabbit.urdf", base="left_foot",
+                        base_joint=Joint("revolute", axis=(0, 1, 0)), base_coordinate="stance")
+    q = {str(s): s for s in m.q}
+    swap = {q["left_knee"]: q["right_knee"], q["left_hip"]: q["right_hip"],
+            q["right_hip"]: q["left_hip"], q["right_knee"]: q["left_knee"],
+            # the new stance foot's absolute angle (reversed joints turn by −q)
+            q["stance"]: q["stance"] - q["left_knee"] - q["left_hip"] + q["right_hip"] + q["right_knee"]}
+    w = walker(m, foot="right_foot", hip="torso", slope=0.0, relabel=swap)
+    names = [str(s) for s in m.q]
+    n = len(names)
+    x0 = np.zeros(2 * n)
+    x0[names.index("left_hip")], x0[names.index("right_hip")] = 0.25, -0.25
+    x0[n + names.index("stance")] = -1.0
+    tr = simulate(w, x0=x0, steps=1, t_end=3.0)
+    (ev,) = [e for e in tr.events if e.name == "heel_strike"]
+    k = build(w)
+    pos, vel = k.kinematics_rows(np.zeros(1), np.zeros(1, dtype=np.int64), ev.x_pre[None, :], np.zeros(1))
+    foot = k.meta["points"].index("right_foot")
+    assert abs(pos[0, foot, 2]) < 1e-9 and vel[0, foot, 2] < 0  # the swing foot lands
+    x = ev.x_post
+    assert [x[names.index(a)] for a in ("left_knee", "left_hip")] == pytest.approx(
+        [ev.x_pre[names.index(a)] for a in ("right_knee", "right_hip")], abs=0)
+    e = k.energy_rows(np.zeros(2), np.zeros(2, dtype=np.int64), np.array([ev.x_pre, ev.x_post]), np.zeros(1))
+    assert e[1, 0] < e[0, 0]  # a plastic impact loses kinetic energy
+    assert e[1, 1] == pytest.approx(e[0, 1], rel=1e-12)  # the relabelling keeps the pose

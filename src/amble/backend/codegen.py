@@ -12,7 +12,7 @@ the right-hand side is inlined into the integrator.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -155,7 +155,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         gdot = []
         for tr in trs:
             ge = sp.sympify(tr.guard.expr)
-            gdot.append(sp.diff(ge, t) + sum((sp.diff(ge, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)))
+            gdot.append(m.diff(ge, t) + sum((m.diff(ge, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)))
         w(f"static void guards_dot_{k}(double t, const double *x, const double *dx, const double *p, double *g) {{\n")
         w("    (void)t; (void)x; (void)dx; (void)p; (void)g;\n")
         w(_block([f"g[{i}]" for i in range(len(trs))], gdot, nm_d))
@@ -269,6 +269,13 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
         body += _block([f"y[{j}]" for j in range(2 * nd)], qn + vn, nm)
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
         return head + body + "}\n"
+    prelude = ""
+    if eq.compact is not None:  # a rigid-body tree: M with its named intermediate quantities
+        defs, Mc, _ = eq.compact
+        eq = replace(eq, M=Mc)
+        nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
+        pr = _Printer(nm)
+        prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
     imp = impulse_data(m, eq, reset, dst.model, what)  # Impact or Lock (validated when declared)
     Me, Jc, qn, dq = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
     ne, nc = Me.shape[0], Jc.shape[0]
@@ -281,7 +288,7 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
     ex += qn
     tg += [f"T[{a * n + b}]" for a in range(nd) for b in range(n)]
     ex += [dq[a, b] for a in range(nd) for b in range(n)]
-    body += _block(tg, ex, nm)
+    body += _block(tg, ex, nm, prelude=prelude)
     body += f"    for (int j = 0; j < {ne}; ++j) v[j] = j < {n} ? x[{n} + j] : 0.0;\n"
     body += f"    int err = amble_impulse({ne}, {nc}, Me, Jc, v);\n    if (err) return err;\n"
     body += f"    for (int a = 0; a < {nd}; ++a) {{\n        double s = 0.0;\n"

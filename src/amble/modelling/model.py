@@ -25,7 +25,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
-from .geometry import free_symbols, t, vector
+from .geometry import dag_diff, free_symbols, t, vector
 from .tree import RigidTree
 
 
@@ -68,8 +68,7 @@ class Model:
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
-        #: the rigid-body tree, if bodies and joints were declared (:meth:`rigid_tree`)
-        self.tree: RigidTree | None = None
+        self.tree: RigidTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
 
     # ------------------------------------------------------------------ symbols
     def coordinates(self, names: str | Sequence[str], unit: str = "rad") -> tuple[sp.Symbol, ...]:
@@ -145,12 +144,22 @@ class Model:
                         return self.tree.point_velocities[name]
             return expr.applyfunc(self.dt)
         expr = sp.sympify(expr)
-        out = sp.diff(expr, t)
+        out = self.diff(expr, t)
         for qi, vi in zip(self.q, self.qd):
-            d = sp.diff(expr, qi)
+            d = self.diff(expr, qi)
             if d != 0:
                 out += d * vi
         return out
+
+    def diff(self, expr: Any, symbol: sp.Symbol) -> sp.Expr:
+        """``∂expr/∂symbol`` (a tree model's shared subexpressions visited once: ``dag_diff``)."""
+        return sp.diff(expr, symbol) if self.tree is None else dag_diff(expr, symbol)
+
+    def jacobian(self, expr: Any) -> sp.Matrix:
+        """``∂expr/∂q`` of a vector expression (e.g. a point's position), one column per coordinate."""
+        v = sp.Matrix(expr)
+        return v.jacobian(self.q) if self.tree is None else sp.Matrix(
+            v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j]))
 
     # ------------------------------------------------------------------ geometry
     def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
@@ -200,14 +209,15 @@ class Model:
 
     @classmethod
     def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,
-                  name: str | None = None, allow_massless: bool = False, gravity: float = 9.81) -> Model:
-        """A model of the robot in a URDF file with ``base`` (a link name; default: the root)
-        fixed to the world, named ``contact_points`` ``{name: (link, (x, y, z))}`` and gravity
-        ``gravity`` along −z — see :mod:`amble.modelling.urdf`."""
+                  name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
+                  base_joint: Any = None, base_coordinate: str = "base") -> Model:
+        """The robot of a URDF file with the link ``base`` fixed to the world (or attached by
+        ``base_joint``), and ``contact_points`` — see :mod:`amble.modelling.urdf`."""
         from .urdf import build_model
 
         return build_model(cls, path, base=base, contact_points=contact_points, name=name,
-                           allow_massless=allow_massless, gravity=gravity)
+                           allow_massless=allow_massless, gravity=gravity, base_joint=base_joint,
+                           base_coordinate=base_coordinate)
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
@@ -323,7 +333,7 @@ class Model:
         if point not in self.points:
             raise ModelError(f"model {self.name!r}: force on unknown point {point!r}")
         f = sp.Matrix(force)
-        jac = self.points[point].jacobian(self.q)
+        jac = self.jacobian(self.points[point])
         self._forces.append(jac.T * f)
 
     @property
@@ -342,9 +352,8 @@ class Model:
         Positions, energies and masses are substituted; generalized forces are mapped by virtual
         work, ``Γ_new = (∂q/∂q_new)ᵀ Γ``, so a torque declared once acts correctly in both modes.
         """
-        if self.tree is not None:
-            raise ModelError(f"model {self.name!r}: constrained() of a rigid-body tree model is not "
-                             "supported; declare the locked joint as fixed in a second model")
+        if self.tree is not None:  # declare the locked joint fixed in a second model instead
+            raise ModelError(f"model {self.name!r}: constrained() of a rigid-body tree is not supported")
         subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
         for k in subs:
             if k not in self.q:

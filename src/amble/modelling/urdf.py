@@ -65,9 +65,11 @@ def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
 
 
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
-                name: str | None = None, allow_massless: bool = False, gravity: float = 9.81) -> Any:
+                name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
+                base_joint: Joint | None = None, base_coordinate: str = "base") -> Any:
     """A model (of class ``cls``, a :class:`~amble.modelling.model.Model`) of the URDF at ``path``
-    with ``base`` fixed to the world (default: the URDF's root link)."""
+    with ``base`` fixed to the world (default: the URDF's root link), or attached to it by
+    ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``."""
     path = Path(path)
     robot = _read(path).robot
     links = {lk.name: lk for lk in robot.links}
@@ -121,7 +123,15 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
     model = cls(name or robot.name or path.stem, dims=3)
     model.gravity(gravity)
     tree = model.rigid_tree()
+    top = None
+    if base_joint is not None:
+        link = links[base]
+        mass, com, inertia = (_check_inertial(link) if link.inertial is not None
+                              else (0.0, np.zeros(3), np.zeros((3, 3))))
+        tree.body(base, joint=base_joint, mass=mass, com=tuple(com), inertia=inertia, coordinate=base_coordinate)
+        top = base
     for lk, parent, j, forward in order:
+        parent = parent or top
         link = links[lk]
         if link.inertial is None:
             if j.type != "fixed" and not allow_massless:
@@ -149,7 +159,7 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             lk, at = spec
         except (TypeError, ValueError):
             raise ModelError(f"contact point {pname!r}: give (link, (x, y, z)), got {spec!r}") from None
-        if lk == base:
+        if lk == base and base_joint is None:
             raise ModelError(f"contact point {pname!r} is on the base link {base!r}, which does not move")
         tree.point(pname, lk, at)
     return model
