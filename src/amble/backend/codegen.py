@@ -12,7 +12,7 @@ the right-hand side is inlined into the integrator.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -35,6 +35,8 @@ class _Printer(C99CodePrinter):
     def _print_Symbol(self, expr: sp.Symbol) -> str:
         name = self._names.get(expr)
         return name if name is not None else super()._print_Symbol(expr)
+
+    _print_Dummy = _print_Symbol
 
     def _print_Pow(self, expr: sp.Pow) -> str:
         base, e = expr.base, expr.exp
@@ -65,13 +67,16 @@ def _names(model: Model, params: list[str]) -> dict[sp.Symbol, str]:
     return names
 
 
-def _block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ") -> str:
-    """C statements assigning ``exprs`` to ``targets`` with shared subexpressions."""
+def _block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ",
+           prelude: str = "") -> str:
+    """C statements assigning ``exprs`` to ``targets`` with shared subexpressions (after
+    ``prelude``, the statements of named intermediate quantities the expressions may use)."""
     if not exprs:
         return ""
     repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
     pr = _Printer(names)
-    lines = [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
+    lines = [prelude] if prelude else []
+    lines += [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
     lines += [f"{indent}{tgt} = {pr.doprint(e)};" for tgt, e in zip(targets, reduced)]
     return "\n".join(lines) + "\n"
 
@@ -121,24 +126,29 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         m, eq, k = mi.model, mi.equations, mi.index
         n = len(m.q)
         nm = _names(m, params)
+        # a rigid-body tree's M and h come with their intermediate quantities (Equations.compact)
+        defs, eqM, eqh = eq.compact if eq.compact is not None else ((), eq.M, eq.h)
+        nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
+        pr = _Printer(nm)
+        prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
         # right-hand side: q̈ = M⁻¹ (Γ − h)
         tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)]
-        ex = [eq.M[i, j] for i in range(n) for j in range(i + 1)]
+        ex = [eqM[i, j] for i in range(n) for j in range(i + 1)]
         tg += [f"f[{i}]" for i in range(n)]
-        ex += [eq.Gamma[i] - eq.h[i] for i in range(n)]
+        ex += [eq.Gamma[i] - eqh[i] for i in range(n)]
         w(f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n")
         w(f"    double M[{n * n}], f[{n}];\n    (void)t; (void)p;\n")
-        w(_block(tg, ex, nm))
+        w(_block(tg, ex, nm, prelude=prelude))
         w(f"    int err = amble_chol_solve({n}, M, f);\n")
         w(f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n")
         w("    return err;\n}\n")
         # M, h and Γ separately (analysis and display; the integrator uses rhs above)
         tg = [f"M[{i * n + j}]" for i in range(n) for j in range(n)] + [f"h[{i}]" for i in range(n)]
         tg += [f"G[{i}]" for i in range(n)]
-        ex = [eq.M[i, j] for i in range(n) for j in range(n)] + list(eq.h) + list(eq.Gamma)
+        ex = [eqM[i, j] for i in range(n) for j in range(n)] + list(eqh) + list(eq.Gamma)
         w(f"static void dynamics_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n")
         w("    (void)t; (void)p;\n")
-        w(_block(tg, ex, nm))
+        w(_block(tg, ex, nm, prelude=prelude))
         w("}\n")
         # guards of this mode's transitions
         trs = trs_by_mode[name]
@@ -154,7 +164,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         gdot = []
         for tr in trs:
             ge = sp.sympify(tr.guard.expr)
-            gdot.append(sp.diff(ge, t) + sum((sp.diff(ge, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)))
+            gdot.append(m.diff(ge, t) + sum((m.diff(ge, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)))
         w(f"static void guards_dot_{k}(double t, const double *x, const double *dx, const double *p, double *g) {{\n")
         w("    (void)t; (void)x; (void)dx; (void)p; (void)g;\n")
         w(_block([f"g[{i}]" for i in range(len(trs))], gdot, nm_d))
@@ -291,6 +301,13 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
         body += _block([f"y[{j}]" for j in range(2 * nd)], qn + vn, nm)
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
         return head + body + "}\n"
+    prelude = ""
+    if eq.compact is not None:  # a rigid-body tree: M with its named intermediate quantities
+        defs, Mc, _ = eq.compact
+        eq = replace(eq, M=Mc)
+        nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
+        pr = _Printer(nm)
+        prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
     imp = impulse_data(m, eq, reset, dst.model, what)  # Impact or Lock (validated when declared)
     Me, Jc, qn, dq = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
     ne, nc = Me.shape[0], Jc.shape[0]
@@ -303,7 +320,7 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
     ex += qn
     tg += [f"T[{a * n + b}]" for a in range(nd) for b in range(n)]
     ex += [dq[a, b] for a in range(nd) for b in range(n)]
-    body += _block(tg, ex, nm)
+    body += _block(tg, ex, nm, prelude=prelude)
     body += f"    for (int j = 0; j < {ne}; ++j) v[j] = j < {n} ? x[{n} + j] : 0.0;\n"
     body += f"    int err = amble_impulse({ne}, {nc}, Me, Jc, v);\n    if (err) return err;\n"
     body += f"    for (int a = 0; a < {nd}; ++a) {{\n        double s = 0.0;\n"

@@ -19,6 +19,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..modelling.model import Model, t
+from .tree import tree_dynamics
 
 
 @dataclass
@@ -33,6 +34,10 @@ class Equations:
     V: sp.Expr | None
     energy: sp.Expr
     _qdd: list[sp.Symbol] = field(default_factory=list)
+    #: the same ``M`` and ``h`` written with named intermediate quantities (a rigid-body tree's
+    #: recursion): ``(definitions, M, h)``, definitions as ``(symbol, expression)`` in order —
+    #: code generation prints these instead of searching the expanded ones for common parts
+    compact: tuple[list[tuple[sp.Symbol, sp.Expr]], sp.Matrix, sp.Matrix] | None = None
 
     @property
     def q(self) -> list[sp.Symbol]:
@@ -67,6 +72,9 @@ class Equations:
 
     def count_ops(self) -> int:
         """Arithmetic operations needed to evaluate M, h and Γ with common subexpressions shared."""
+        if self.compact is not None:
+            defs, M, h = self.compact
+            return int(sum(sp.count_ops(e) for _, e in defs)) + count_ops_cse([*M, *h, *self.Gamma])
         return count_ops_cse([*self.M, *self.h, *self.Gamma])
 
     def latex(self, display: bool = False) -> str:
@@ -152,13 +160,16 @@ def derive(model: Model) -> Equations:
     energy: with ``vᵢ = Jᵢ q̇`` and the convective acceleration ``aᵢ = (∂vᵢ/∂q) q̇``,
     ``M = Σ mᵢ JᵢᵀJᵢ`` and ``h = Σ mᵢ Jᵢᵀaᵢ + ∂V/∂q``. Every other energy term (rotational
     inertia, added terms, or ``K``/``V``/``L`` given outright) goes through the general
-    Euler–Lagrange expansion above. Both routes give the same equations.
+    Euler–Lagrange expansion above. Both routes give the same equations. The bodies of a
+    rigid-body tree (``model.rigid_tree()``) take a third route, by recursion over the tree
+    (:mod:`amble.derivation.tree`: composite rigid bodies for ``M``, Newton–Euler for ``h``).
     """
     model.validate()
     q, qd = model.q, model.qd
     n = len(q)
     M = sp.zeros(n, n)
     h = sp.zeros(n, 1)
+    Mt = ht = None
     given_l = model._l_override is not None
     if given_l:
         _add_lagrangian_terms(model.L, q, qd, M, h)
@@ -166,11 +177,13 @@ def derive(model: Model) -> Equations:
         if model._k_override is not None:
             _add_lagrangian_terms(model._k_override, q, qd, M, h)
         else:
+            if model.tree is not None:
+                Mt, ht = tree_dynamics(model.tree, model.gravity_vector)
             _add_point_masses(model, M, h)
             extra = sum(model._k_terms, sp.Integer(0))
             if extra != 0:
                 _add_lagrangian_terms(extra, q, qd, M, h)
-        V = model.V
+        V = _potential_outside_tree(model) if model._k_override is None else model.V
         for i in range(n):
             h[i] += sp.diff(V, q[i])
     K = None if given_l else model.K
@@ -181,7 +194,13 @@ def derive(model: Model) -> Equations:
     else:
         # E = K + V is what is conserved when Γ = 0 and nothing depends on t explicitly.
         energy = K + V
-    return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy)
+    compact = None
+    if Mt is not None:
+        defs = model.tree.defs
+        compact = (defs.needed([*Mt, *ht]), M + Mt, h + ht)
+        M, h = M + defs.expand(Mt), h + defs.expand(ht)
+    return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy,
+                     compact=compact)
 
 
 def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:
@@ -189,6 +208,8 @@ def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:
     qd_vec = sp.Matrix(qd)
     n = len(q)
     for name, m in model.masses.items():
+        if model.tree is not None and name in model.tree.com_points:
+            continue  # the tree's bodies are in tree_dynamics
         pos = model.points[name]
         J = pos.jacobian(q)
         if t in pos.free_symbols:
@@ -209,6 +230,18 @@ def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:
             hi = m * (J[:, i].T * a)[0, 0]
             if hi != 0:
                 h[i] += hi
+
+
+def _potential_outside_tree(model: Model) -> sp.Expr:
+    """``V`` without the gravity of the tree's bodies (which ``tree_dynamics`` includes in h)."""
+    if model.tree is None or model._v_override is not None:
+        return model.V
+    gvec = model.gravity_vector
+    v = sp.Integer(0)
+    for name, m in model.masses.items():
+        if name not in model.tree.com_points:
+            v += -m * (gvec.T * model.points[name])[0, 0]
+    return v + sum(model._v_terms, sp.Integer(0))
 
 
 def _add_lagrangian_terms(lag: sp.Expr, q: list, qd: list, M: sp.Matrix, h: sp.Matrix) -> None:

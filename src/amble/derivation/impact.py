@@ -71,7 +71,7 @@ def extended_impact_data(model: Model, equations: Equations, point: str) -> tupl
     S = sp.zeros(n, d)
     mt = sp.Integer(0)
     for name, m in model.masses.items():
-        J = model.points[name].jacobian(model.q)
+        J = model.jacobian(model.points[name])
         S += m * J.T
         mt += m
     Me = sp.zeros(n + d, n + d)
@@ -80,7 +80,7 @@ def extended_impact_data(model: Model, equations: Equations, point: str) -> tupl
     Me[n:, :n] = S.T
     Me[n:, n:] = mt * sp.eye(d)
     Jc = sp.zeros(d, n + d)
-    Jc[:, :n] = model.points[point].jacobian(model.q)
+    Jc[:, :n] = model.jacobian(model.points[point])
     Jc[:, n:] = sp.eye(d)
     return Me, Jc
 

@@ -37,3 +37,72 @@ def vector(*components: Any) -> sp.Matrix:
     if len(components) == 1 and isinstance(components[0], Iterable):
         components = tuple(components[0])
     return sp.Matrix([sp.sympify(c) for c in components])
+
+
+def free_symbols(expr: Any) -> set[sp.Symbol]:
+    """Free symbols of an expression or matrix, visiting each shared subexpression once (the
+    expressions of a rigid-body tree are DAGs: a plain traversal would revisit shared parts)."""
+    roots = list(expr) if isinstance(expr, sp.MatrixBase) else [sp.sympify(expr)]
+    seen: set[int] = set()
+    out: set[sp.Symbol] = set()
+    stack = roots
+    while stack:
+        x = stack.pop()
+        if id(x) in seen:
+            continue
+        seen.add(id(x))
+        if x.is_Symbol:
+            out.add(x)
+        elif not x.is_Atom:
+            stack.extend(x.args)
+    return out
+
+
+def dag_diff(expr: Any, x: sp.Symbol, memo: dict | None = None) -> sp.Expr:
+    """``∂expr/∂x`` visiting each shared subexpression once (sympy's ``diff`` revisits them,
+    which is exponential in the depth of a rigid-body tree's kinematics). The result shares
+    subexpressions with ``expr``; it is built unevaluated where that keeps sharing."""
+    memo = {} if memo is None else memo
+    zero = sp.Integer(0)
+    stack = [sp.sympify(expr)]
+    while stack:
+        e = stack[-1]
+        if e in memo:
+            stack.pop()
+            continue
+        if e.is_Atom:
+            memo[e] = sp.Integer(1) if e == x else zero
+            stack.pop()
+            continue
+        if not isinstance(e, (sp.Add, sp.Mul, sp.Pow, sp.sin, sp.cos)):
+            memo[e] = sp.diff(e, x)
+            stack.pop()
+            continue
+        todo = [a for a in e.args if a not in memo]
+        if todo:
+            stack.extend(todo)
+            continue
+        d = [memo[a] for a in e.args]
+        if isinstance(e, sp.Add):
+            terms = [di for di in d if di != 0]
+            out = zero if not terms else terms[0] if len(terms) == 1 else sp.Add(*terms, evaluate=False)
+        elif isinstance(e, sp.Mul):
+            terms = []
+            for i, di in enumerate(d):
+                if di != 0:
+                    rest = [a for j, a in enumerate(e.args) if j != i]
+                    terms.append(sp.Mul(*rest, di, evaluate=False) if di != 1 else sp.Mul(*rest, evaluate=False))
+            out = zero if not terms else terms[0] if len(terms) == 1 else sp.Add(*terms, evaluate=False)
+        elif isinstance(e, sp.Pow):
+            b, n = e.args
+            if d[1] != 0:
+                out = sp.diff(e, x)
+            else:
+                out = sp.Mul(n, sp.Pow(b, n - 1), d[0], evaluate=False) if d[0] != 0 else zero
+        elif isinstance(e, sp.sin):
+            out = sp.Mul(sp.cos(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
+        else:
+            out = sp.Mul(-1, sp.sin(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
+        memo[e] = out
+        stack.pop()
+    return memo[sp.sympify(expr)]

@@ -26,8 +26,9 @@ import sympy as sp
 from ..errors import ModelError
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
-from .geometry import t
+from .geometry import dag_diff, free_symbols, t
 from .names import Names
+from .tree import RigidTree
 
 
 class Model(Names):
@@ -62,18 +63,34 @@ class Model(Names):
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
+        self.tree: RigidTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
 
     def dt(self, expr: Any) -> Any:
-        """Total time derivative of an expression (or vector) of q and t, by the chain rule."""
+        """Total time derivative of an expression (or vector) of q and t, by the chain rule
+        (the velocity of a point on a rigid-body tree comes from the tree, undifferentiated)."""
         if isinstance(expr, sp.MatrixBase):
+            if self.tree is not None:
+                for name, pos in self.points.items():
+                    if pos is expr and name in self.tree.point_velocities:
+                        return self.tree.point_velocities[name]
             return expr.applyfunc(self.dt)
         expr = sp.sympify(expr)
-        out = sp.diff(expr, t)
+        out = self.diff(expr, t)
         for qi, vi in zip(self.q, self.qd):
-            d = sp.diff(expr, qi)
+            d = self.diff(expr, qi)
             if d != 0:
                 out += d * vi
         return out
+
+    def diff(self, expr: Any, symbol: sp.Symbol) -> sp.Expr:
+        """``∂expr/∂symbol`` (a tree model's shared subexpressions visited once: ``dag_diff``)."""
+        return sp.diff(expr, symbol) if self.tree is None else dag_diff(expr, symbol)
+
+    def jacobian(self, expr: Any) -> sp.Matrix:
+        """``∂expr/∂q`` of a vector expression (e.g. a point's position), one column per coordinate."""
+        v = sp.Matrix(expr)
+        return v.jacobian(self.q) if self.tree is None else sp.Matrix(
+            v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j]))
 
     # ------------------------------------------------------------------ geometry
     def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
@@ -112,6 +129,25 @@ class Model(Names):
             if p not in self.points:
                 raise ModelError(f"model {self.name!r}: link to unknown point {p!r}")
         self.links.append((a, b))
+
+    def rigid_tree(self) -> RigidTree:
+        """The model's kinematic tree of rigid bodies and joints (created on first use; 3D only):
+        ``model.rigid_tree().body(...)`` — see :mod:`amble.modelling.tree`."""
+        if self.tree is None:
+            self.tree = RigidTree(self)
+        return self.tree
+
+    @classmethod
+    def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,
+                  name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
+                  base_joint: Any = None, base_coordinate: str = "base") -> Model:
+        """The robot of a URDF file with the link ``base`` fixed to the world (or attached by
+        ``base_joint``), and ``contact_points`` — see :mod:`amble.modelling.urdf`."""
+        from .urdf import build_model
+
+        return build_model(cls, path, base=base, contact_points=contact_points, name=name,
+                           allow_massless=allow_massless, gravity=gravity, base_joint=base_joint,
+                           base_coordinate=base_coordinate)
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
@@ -158,8 +194,10 @@ class Model(Names):
         """Kinetic energy: Σ ½ mᵢ |ṗᵢ|² plus added terms, unless given outright."""
         if self._k_override is not None:
             return self._k_override
-        k = sp.Integer(0)
+        k = sp.Integer(0) if self.tree is None else self.tree.kinetic()
         for name, m in self.masses.items():
+            if self.tree is not None and name in self.tree.com_points:
+                continue
             v = self.dt(self.points[name])
             k += sp.Rational(1, 2) * m * (v.T * v)[0, 0]
         return k + sum(self._k_terms, sp.Integer(0))
@@ -175,7 +213,11 @@ class Model(Names):
             return self._v_override
         v = sp.Integer(0)
         gvec = self.gravity_vector
+        if self.tree is not None:
+            v = self.tree.potential(gvec)
         for name, m in self.masses.items():
+            if self.tree is not None and name in self.tree.com_points:
+                continue
             v += -m * (gvec.T * self.points[name])[0, 0]
         return v + sum(self._v_terms, sp.Integer(0))
 
@@ -224,7 +266,7 @@ class Model(Names):
         if point not in self.points:
             raise ModelError(f"model {self.name!r}: force on unknown point {point!r}")
         f = _matrix(self.name, force, f"force on point {point!r}")
-        jac = self.points[point].jacobian(self.q)
+        jac = self.jacobian(self.points[point])
         self._forces.append(jac.T * f)
 
     @property
@@ -243,6 +285,8 @@ class Model(Names):
         Positions, energies and masses are substituted; generalized forces are mapped by virtual
         work, ``Γ_new = (∂q/∂q_new)ᵀ Γ``, so a torque declared once acts correctly in both modes.
         """
+        if self.tree is not None:  # declare the locked joint fixed in a second model instead
+            raise ModelError(f"model {self.name!r}: constrained() of a rigid-body tree is not supported")
         subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
         for k in subs:
             if k not in self.q:
@@ -280,7 +324,7 @@ class Model(Names):
 
     def _check_symbols(self, expr: Any, what: str) -> None:
         allowed = set(self.q) | set(self.params) | {t}
-        free = sp.sympify(expr).free_symbols if not isinstance(expr, sp.MatrixBase) else expr.free_symbols
+        free = free_symbols(expr)
         bad = sorted(str(s) for s in free - allowed)
         if bad:
             raise ModelError(
@@ -304,15 +348,15 @@ class Model(Names):
                 )
         allowed_kv = set(self.q) | set(self.qd) | set(self.params) | {t}
         for label, expr in (("K", self.K), ("V", self.V), ("L", self.L)):
-            bad = sorted(str(s) for s in expr.free_symbols - allowed_kv)
+            bad = sorted(str(s) for s in free_symbols(expr) - allowed_kv)
             if bad:
                 raise ModelError(
                     f"model {self.name!r}: {label} uses {', '.join(bad)}, which is neither a "
                     "coordinate, a velocity nor a parameter"
                 )
-        if any(s in self.V.free_symbols for s in self.qd):
+        if any(s in free_symbols(self.V) for s in self.qd):
             raise ModelError(f"model {self.name!r}: the potential energy V depends on velocities")
-        bad = sorted(str(s) for s in self.generalized_force.free_symbols - allowed_kv)
+        bad = sorted(str(s) for s in free_symbols(self.generalized_force) - allowed_kv)
         if bad:
             raise ModelError(f"model {self.name!r}: forces use unknown symbols {', '.join(bad)}")
 
@@ -321,3 +365,4 @@ class Model(Names):
             f"Model({self.name!r}, dims={self.dims}, q=[{', '.join(map(str, self.q))}], "
             f"params=[{', '.join(self.parameter_names)}])"
         )
+

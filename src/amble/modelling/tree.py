@@ -1,0 +1,367 @@
+"""Rigid bodies and joints: a kinematic tree as a modelling object.
+
+A :class:`RigidTree` belongs to a :class:`~amble.modelling.model.Model` (``model.rigid_tree()``).
+Each :class:`Body` hangs from a parent body (or from the fixed base) by a :class:`Joint`:
+
+* ``revolute`` about a unit ``axis`` (``continuous`` is a revolute joint without limits),
+* ``prismatic`` along a unit ``axis``,
+* ``fixed`` (no coordinate).
+
+A joint has an origin in its parent's frame — a translation ``xyz`` and a rotation ``rpy``
+(roll, pitch, yaw about fixed x, y, z: ``R = Rz(yaw) Ry(pitch) Rx(roll)``), the URDF conventions —
+and the joint motion follows the origin. The body has a mass, a centre of mass and a full 3×3
+inertia tensor about the centre of mass, both in the body frame (numbers or expressions of the
+model's parameters).
+
+Each moving joint's coordinate becomes a model coordinate; each body's centre of mass becomes a
+named point carrying its mass, and :meth:`RigidTree.point` names further points on bodies — so
+guards, impacts and drawing see an ordinary model. The world-frame kinematics are built by
+recursion over the tree, each body from its parent only: ``Rᵢ = R_parent Xᵢ(qᵢ)``,
+``pᵢ = p_parent + R_parent oᵢ``, ``ωᵢ = ω_parent + q̇ᵢ zᵢ``, … — expressions that share their
+parents' and are never differentiated (:mod:`amble.derivation.tree` builds ``M`` and ``h`` from them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from ..errors import ModelError
+
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
+
+
+class Defs:
+    """Intermediate quantities of a recursion: each non-trivial expression is named by a fresh
+    symbol, so every step works on small expressions (sympy's cost grows with their size).
+
+    :meth:`expand` turns an expression of these symbols back into one of q, q̇ and parameters,
+    as a DAG: each definition is rebuilt once, unevaluated (no flattening, no distribution of
+    numeric factors), and shared by every use — common subexpressions for code generation.
+    """
+
+    def __init__(self) -> None:
+        self._defs: dict[sp.Symbol, sp.Expr] = {}
+        self._done: dict[sp.Basic, sp.Basic] = {}
+
+    def __call__(self, e: Any) -> sp.Expr:
+        e = sp.sympify(e)
+        if e.is_Atom or isinstance(e, sp.Function) or (
+                e.is_Mul and len(e.args) == 2 and e.args[0].is_Number and e.args[1].is_Atom):
+            return e
+        s = sp.Dummy(f"k{len(self._defs)}")
+        self._defs[s] = e
+        return s
+
+    def vec(self, m: sp.Matrix) -> sp.Matrix:
+        return m.applyfunc(self)
+
+    def needed(self, exprs: Any) -> list[tuple[sp.Symbol, sp.Expr]]:
+        """The definitions that ``exprs`` use, directly or not, in an order where each comes
+        after those it uses."""
+        used: set[sp.Symbol] = set()
+        stack = [e for e in exprs]
+        seen: set[sp.Basic] = set()
+        while stack:
+            x = sp.sympify(stack.pop())
+            if x in seen:
+                continue
+            seen.add(x)
+            if isinstance(x, sp.Dummy) and x in self._defs:
+                used.add(x)
+                stack.append(self._defs[x])
+            elif not x.is_Atom:
+                stack.extend(x.args)
+        return [(s, e) for s, e in self._defs.items() if s in used]
+
+    def expand(self, e: Any) -> Any:
+        """``e`` (an expression or matrix of the defined symbols) in q, q̇ and parameters."""
+        if isinstance(e, sp.MatrixBase):
+            return e.applyfunc(self.expand)
+        done = self._done
+        stack = [sp.sympify(e)]
+        while stack:
+            x = stack[-1]
+            if x in done:
+                stack.pop()
+                continue
+            src = self._defs.get(x, x) if isinstance(x, sp.Dummy) else x
+            if src is not x:
+                if src in done:
+                    done[x] = done[src]
+                    stack.pop()
+                else:
+                    stack.append(src)
+                continue
+            if x.is_Atom:
+                done[x] = x
+                stack.pop()
+                continue
+            todo = [a for a in x.args if a not in done]
+            if todo:
+                stack.extend(todo)
+                continue
+            args = [done[a] for a in x.args]
+            if isinstance(x, (sp.Add, sp.Mul)):
+                done[x] = x.func(*args, evaluate=False)
+            else:
+                done[x] = x.func(*args)
+            stack.pop()
+        return done[sp.sympify(e)]
+
+
+def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
+    """Rotation of URDF roll-pitch-yaw angles: ``Rz(yaw) Ry(pitch) Rx(roll)``."""
+    r, p, y = (float(a) for a in rpy)
+    cr, sr, cp, sp_, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    ry = np.array([[cp, 0, sp_], [0, 1, 0], [-sp_, 0, cp]])
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    return rz @ ry @ rx
+
+
+def _num(x: Any) -> sp.Expr:
+    """A number or expression as sympy; integral floats become exact integers (sparser trees)."""
+    if isinstance(x, sp.Basic):
+        return x
+    v = float(x)
+    if v == 0.0:
+        return sp.Integer(0)
+    if v.is_integer() and abs(v) < 2**31:
+        return sp.Integer(int(v))
+    return sp.Float(v, 17)
+
+
+def _vec(xs: Any) -> sp.Matrix:
+    return sp.Matrix([_num(x) for x in xs])
+
+
+def _mat3(xs: Any) -> sp.Matrix:
+    if isinstance(xs, sp.MatrixBase):
+        return sp.Matrix(xs)
+    a = np.asarray(xs, dtype=object)
+    return sp.Matrix(3, 3, [_num(v) for v in a.reshape(-1)])
+
+
+def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
+    """Rodrigues' rotation about a unit axis, by cos ``c`` and sin ``s`` (sparse for x, y, z)."""
+    x, y, z = axis
+    C = 1 - c
+    return sp.Matrix([
+        [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+        [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+        [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
+    ])
+
+
+@dataclass
+class Joint:
+    """A joint between a parent and a child body (see the module docstring for the types).
+
+    ``xyz``/``rpy`` (or ``rotation``, a 3×3 matrix) place the joint frame in the parent's frame;
+    ``post_xyz``/``post_rotation`` an optional fixed offset after the motion (a reversed joint,
+    when a tree is re-rooted). ``lower``/``upper`` are limits (``None``: none).
+    """
+
+    type: str = "revolute"
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+    xyz: Sequence[float] = (0.0, 0.0, 0.0)
+    rpy: Sequence[float] = (0.0, 0.0, 0.0)
+    rotation: Any = None
+    post_xyz: Sequence[float] | None = None
+    post_rotation: Any = None
+    lower: float | None = None
+    upper: float | None = None
+
+
+@dataclass
+class Body:
+    """A rigid body of a tree, with its world-frame kinematics once added."""
+
+    name: str
+    parent: Body | None
+    joint: Joint
+    mass: sp.Expr
+    com: sp.Matrix
+    inertia: sp.Matrix
+    coordinate: sp.Symbol | None = None
+    #: index of the coordinate in the model's q (None for a fixed joint)
+    index: int | None = None
+    R: sp.Matrix = field(default_factory=lambda: sp.eye(3))      # body → world
+    p: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))  # body origin, world
+    #: joint axis (world) and a point on it (world); zero axis for a fixed joint
+    axis_w: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
+    axis_point: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
+    omega: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))  # angular velocity, world
+    vel: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))    # velocity of the body origin
+
+    @property
+    def moving(self) -> bool:
+        return self.coordinate is not None
+
+    @property
+    def com_world(self) -> sp.Matrix:
+        return self.p + self.R * self.com
+
+
+class RigidTree:
+    """A kinematic tree of rigid bodies in a 3D model (created by ``Model.rigid_tree()``)."""
+
+    def __init__(self, model: Any) -> None:
+        if model.dims != 3:
+            raise ModelError(f"model {model.name!r}: a rigid-body tree needs a 3D model (dims=3)")
+        self.model = model
+        self.bodies: list[Body] = []
+        self._by_name: dict[str, Body] = {}
+        #: names of the model points that are body centres of mass (their masses are the bodies')
+        self.com_points: dict[str, Body] = {}
+        #: velocity of each point defined on a body, by point name (no differentiation needed)
+        self.point_velocities: dict[str, sp.Matrix] = {}
+        self.limits: dict[str, tuple[float | None, float | None]] = {}
+        #: intermediate quantities of the recursions (body kinematics here, dynamics in derivation)
+        self.defs = Defs()
+        self._energies: dict[tuple, sp.Expr] = {}
+
+    # ------------------------------------------------------------------ building
+    def body(self, name: str, parent: str | None = None, joint: Joint | None = None, mass: Any = 0,
+             com: Sequence[Any] = (0, 0, 0), inertia: Any = ((0, 0, 0), (0, 0, 0), (0, 0, 0)),
+             coordinate: str | None = None, unit: str | None = None) -> Body:
+        """Add a body hanging from ``parent`` (``None``: the fixed base) by ``joint``.
+
+        A moving joint declares the model coordinate ``coordinate`` (default: the body's name),
+        in rad for a revolute joint and m for a prismatic one. The centre of mass becomes the
+        model point ``name`` carrying ``mass``.
+        """
+        joint = joint or Joint()
+        m = self.model
+        if name in self._by_name:
+            raise ModelError(f"model {m.name!r}: body {name!r} defined twice")
+        if joint.type not in JOINT_TYPES:
+            raise ModelError(f"model {m.name!r}: joint of body {name!r} has unknown type {joint.type!r} "
+                             f"(known: {', '.join(JOINT_TYPES)})")
+        par = None
+        if parent is not None:
+            if parent not in self._by_name:
+                raise ModelError(f"model {m.name!r}: body {name!r} hangs from unknown body {parent!r}")
+            par = self._by_name[parent]
+        mass_e = _num(mass) if isinstance(mass, (int, float)) else sp.sympify(mass)
+        m._check_symbols(mass_e, f"mass of body {name!r}")
+        b = Body(name=name, parent=par, joint=joint, mass=mass_e, com=_vec(com), inertia=_mat3(inertia))
+        if b.com.shape != (3, 1):
+            raise ModelError(f"model {m.name!r}: centre of mass of body {name!r} needs 3 components")
+        if joint.type != "fixed":
+            a = np.asarray([float(v) for v in joint.axis])
+            na = float(np.linalg.norm(a))
+            if a.shape != (3,) or na == 0.0:
+                raise ModelError(f"model {m.name!r}: joint of body {name!r} needs a nonzero 3D axis")
+            joint.axis = tuple(a / na)
+            cname = coordinate or name
+            (b.coordinate,) = m.coordinates([cname], unit=unit or ("m" if joint.type == "prismatic" else "rad"))
+            b.index = m.q.index(b.coordinate)
+            self.limits[cname] = (joint.lower, joint.upper)
+        self._kinematics(b)
+        self.bodies.append(b)
+        self._by_name[name] = b
+        r = self.defs.vec(_matmul(b.R, b.com))
+        m.point(name, self.defs.expand(b.p + r))
+        self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
+        self.com_points[name] = b
+        if mass_e != 0:
+            m.mass(name, mass_e)
+        if par is not None and par.name in m.points:
+            m.link(par.name, name)
+        return b
+
+    def point(self, name: str, body: str, at: Sequence[Any] = (0, 0, 0)) -> sp.Matrix:
+        """Name a point fixed on ``body`` at ``at`` (body frame); returns its world position."""
+        if body not in self._by_name:
+            raise ModelError(f"model {self.model.name!r}: point {name!r} on unknown body {body!r}")
+        b = self._by_name[body]
+        r = self.defs.vec(_matmul(b.R, _vec(at)))
+        pos = self.model.point(name, self.defs.expand(b.p + r))
+        self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
+        return pos
+
+    def __getitem__(self, name: str) -> Body:
+        return self._by_name[name]
+
+    @property
+    def moving_bodies(self) -> list[Body]:
+        return [b for b in self.bodies if b.moving]
+
+    def kinetic(self) -> sp.Expr:
+        """Kinetic energy of the bodies from their velocities: Σ ½ (m |v_c|² + ωᵀ R I Rᵀ ω)."""
+        key = ("K", len(self.bodies))
+        if key in self._energies:
+            return self._energies[key]
+        d = self.defs
+        out = []
+        for b in self.bodies:
+            vc = d.vec(b.vel + b.omega.cross(d.vec(_matmul(b.R, b.com))))
+            wb = d.vec(_matmul(b.R.T, b.omega))
+            iw = d.vec(_matmul(b.inertia, wb))
+            out.append(d(b.mass * d((vc.T * vc)[0, 0]) + d((wb.T * iw)[0, 0])))
+        self._energies[key] = d.expand(sp.Add(*out) / 2)
+        return self._energies[key]
+
+    def potential(self, gravity: sp.Matrix) -> sp.Expr:
+        """Gravitational potential energy of the bodies: Σ −m g·c."""
+        key = ("V", len(self.bodies), tuple(gravity))
+        if key in self._energies:
+            return self._energies[key]
+        d = self.defs
+        out = [d(-b.mass * d(sp.Add(*[g * c for g, c in zip(gravity, d.vec(b.p + _matmul(b.R, b.com))) if g != 0])))
+               for b in self.bodies]
+        self._energies[key] = d.expand(sp.Add(*out))
+        return self._energies[key]
+
+    # ------------------------------------------------------------------ kinematics
+    def _kinematics(self, b: Body) -> None:
+        j = b.joint
+        R0 = b.parent.R if b.parent is not None else sp.eye(3)
+        p0 = b.parent.p if b.parent is not None else sp.zeros(3, 1)
+        w0 = b.parent.omega if b.parent is not None else sp.zeros(3, 1)
+        v0 = b.parent.vel if b.parent is not None else sp.zeros(3, 1)
+        Ro = _mat3(j.rotation) if j.rotation is not None else _mat3(rpy_matrix(j.rpy))
+        pj = _mul_add(R0, _vec(j.xyz), p0)           # joint frame origin, world
+        Rj = self.defs.vec(_matmul(R0, Ro))           # joint frame, world
+        vj = v0 + w0.cross(pj - p0)
+        if j.type == "fixed":
+            R, p, w, v = Rj, pj, w0, vj
+        else:
+            a = _vec(j.axis)
+            z = self.defs.vec(_matmul(Rj, a))
+            qi = b.coordinate
+            qdi = self.model.dot(qi)
+            b.axis_w, b.axis_point = z, pj
+            if j.type == "prismatic":
+                R, p, w, v = Rj, pj + z * qi, w0, vj + w0.cross(z * qi) + z * qdi
+            else:
+                R = _matmul(Rj, _rotation(a, sp.cos(qi), sp.sin(qi)))
+                p, w, v = pj, w0 + z * qdi, vj
+        if j.post_xyz is not None or j.post_rotation is not None:
+            off = _matmul(R, _vec(j.post_xyz or (0, 0, 0)))
+            p = p + off
+            v = v + w.cross(off)
+            if j.post_rotation is not None:
+                R = _matmul(R, _mat3(j.post_rotation))
+        d = self.defs
+        b.R, b.p, b.omega, b.vel = d.vec(R), d.vec(p), d.vec(w), d.vec(v)
+        b.axis_w, b.axis_point = d.vec(b.axis_w), d.vec(b.axis_point)
+
+
+def _matmul(A: sp.Matrix, B: sp.Matrix) -> sp.Matrix:
+    """Product that skips zero terms (constant rotations are sparse)."""
+    out = sp.zeros(A.rows, B.cols)
+    for i in range(A.rows):
+        for k in range(B.cols):
+            out[i, k] = sp.Add(*[A[i, j] * B[j, k] for j in range(A.cols) if A[i, j] != 0 and B[j, k] != 0])
+    return out
+
+
+def _mul_add(A: sp.Matrix, x: sp.Matrix, y: sp.Matrix) -> sp.Matrix:
+    return _matmul(A, x) + y

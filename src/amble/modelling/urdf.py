@@ -1,0 +1,165 @@
+"""URDF import: a robot description file as a model with a rigid-body tree.
+
+The file is read with `yourdfpy <https://github.com/clemense/yourdfpy>`_ — maintained, pure
+Python on top of lxml, and it parses without loading meshes or building a scene graph (the
+alternatives: ``urdfpy`` has had no release since 2020 and pins old dependencies;
+``urdf_parser_py`` is tied to ROS packaging). Only the parsed elements are used: links with their
+inertials, joints with their type, origin, axis and limits. Everything is then checked here, and
+a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
+
+* a joint of a type other than revolute, continuous, prismatic or fixed (``floating`` and
+  ``planar`` included: the base is chosen, not floating),
+* a link reached twice (a kinematic loop, or a link with two parents),
+* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative mass,
+  an inertia tensor that is not symmetric positive definite.
+
+The user chooses the base link, fixed to the world (e.g. the stance foot): the tree is re-rooted
+there, joints between the base and the URDF root are traversed backwards (the same joint
+coordinate, motion inverted). Joint coordinates are named as the joints, the centre of mass of
+each link is a model point named as the link, and ``contact_points`` name further points:
+``{"heel": ("left_foot", (0.0, 0.0, -0.05))}``. Masses and inertias are constants of the model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError
+from .tree import Joint
+
+_SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+
+
+def _read(path: Path) -> Any:
+    try:
+        import yourdfpy
+    except ImportError as e:  # pragma: no cover - a declared dependency
+        raise ModelError("URDF import needs the 'yourdfpy' package (pip install yourdfpy)") from e
+    try:
+        return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
+                                  build_collision_scene_graph=False, load_collision_meshes=False)
+    except Exception as e:  # the parser's own errors (malformed XML, missing attributes)
+        raise ModelError(f"URDF {path.name}: cannot be read: {e}") from e
+
+
+def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass, centre of mass (link frame) and inertia about it (link axes) of a link."""
+    ine = link.inertial
+    mass = float(ine.mass) if ine.mass is not None else 0.0
+    if not mass >= 0.0:
+        raise ModelError(f"URDF link {link.name!r}: negative mass {mass:g}")
+    T = np.eye(4) if ine.origin is None else np.asarray(ine.origin, dtype=float)
+    I = np.zeros((3, 3)) if ine.inertia is None else np.asarray(ine.inertia, dtype=float)
+    if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
+        raise ModelError(f"URDF link {link.name!r}: inertia tensor is not symmetric")
+    ev = np.linalg.eigvalsh(I)
+    if mass > 0 and not ev.min() > 0:
+        raise ModelError(f"URDF link {link.name!r}: inertia tensor is not positive definite "
+                         f"(eigenvalues {', '.join(f'{v:g}' for v in ev)})")
+    Rc = T[:3, :3]
+    return mass, T[:3, 3].copy(), Rc @ I @ Rc.T
+
+
+def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
+                name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
+                base_joint: Joint | None = None, base_coordinate: str = "base") -> Any:
+    """A model (of class ``cls``, a :class:`~amble.modelling.model.Model`) of the URDF at ``path``
+    with ``base`` fixed to the world (default: the URDF's root link), or attached to it by
+    ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``."""
+    path = Path(path)
+    robot = _read(path).robot
+    links = {lk.name: lk for lk in robot.links}
+    joints = list(robot.joints)
+    for j in joints:
+        if j.type not in _SUPPORTED:
+            kind = "unsupported" if j.type in ("floating", "planar") else "unknown"
+            raise ModelError(f"URDF joint {j.name!r}: {kind} joint type {j.type!r} "
+                             f"(supported: {', '.join(_SUPPORTED)})")
+        for end in (j.parent, j.child):
+            if end not in links:
+                raise ModelError(f"URDF joint {j.name!r}: unknown link {end!r}")
+    parents: dict[str, str] = {}
+    for j in joints:
+        if j.child in parents:
+            raise ModelError(f"URDF link {j.child!r} has two parent joints ({parents[j.child]!r}, {j.name!r}): "
+                             "a kinematic loop")
+        parents[j.child] = j.name
+    roots = [lk for lk in links if lk not in parents]
+    if len(roots) != 1:
+        raise ModelError(f"URDF {path.name}: expected one root link, found {len(roots)}"
+                         + (f" ({', '.join(roots)})" if roots else " (the joints form a loop)"))
+    base = base or roots[0]
+    if base not in links:
+        raise ModelError(f"URDF {path.name}: base link {base!r} is not a link "
+                         f"(links: {', '.join(links)})")
+
+    adjacent: dict[str, list[tuple[Any, bool]]] = {lk: [] for lk in links}
+    for j in joints:
+        adjacent[j.parent].append((j, True))
+        adjacent[j.child].append((j, False))
+    order: list[tuple[str, str | None, Any, bool]] = []   # (link, parent link, joint, forward)
+    seen = {base}
+    stack = [base]
+    while stack:
+        lk = stack.pop(0)
+        for j, forward in adjacent[lk]:
+            other = j.child if forward else j.parent
+            if other in seen:
+                continue
+            seen.add(other)
+            order.append((other, None if lk == base else lk, j, forward))
+            stack.append(other)
+    missing = [lk for lk in links if lk not in seen]
+    if missing:
+        raise ModelError(f"URDF {path.name}: links not connected to {base!r}: {', '.join(missing)}")
+
+    for lk in links.values():  # every inertial is checked, the base's too (nothing is silently dropped)
+        if lk.inertial is not None:
+            _check_inertial(lk)
+    model = cls(name or robot.name or path.stem, dims=3)
+    model.gravity(gravity)
+    tree = model.rigid_tree()
+    top = None
+    if base_joint is not None:
+        link = links[base]
+        mass, com, inertia = (_check_inertial(link) if link.inertial is not None
+                              else (0.0, np.zeros(3), np.zeros((3, 3))))
+        tree.body(base, joint=base_joint, mass=mass, com=tuple(com), inertia=inertia, coordinate=base_coordinate)
+        top = base
+    for lk, parent, j, forward in order:
+        parent = parent or top
+        link = links[lk]
+        if link.inertial is None:
+            if j.type != "fixed" and not allow_massless:
+                raise ModelError(f"URDF link {lk!r} is moved by joint {j.name!r} but has no inertial "
+                                 "(give it one, or load with allow_massless=True)")
+            mass, com, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
+        else:
+            mass, com, inertia = _check_inertial(link)
+        T = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+        axis = np.asarray(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+        lower = upper = None
+        if j.type in ("revolute", "prismatic") and j.limit is not None:
+            lower, upper = j.limit.lower, j.limit.upper
+        if forward:
+            joint = Joint(j.type, axis=tuple(axis), xyz=tuple(T[:3, 3]), rotation=T[:3, :3],
+                          lower=lower, upper=upper)
+        else:  # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
+            Rt = T[:3, :3].T
+            joint = Joint(j.type, axis=tuple(-axis), post_xyz=tuple(-Rt @ T[:3, 3]), post_rotation=Rt,
+                          lower=lower, upper=upper)
+        tree.body(lk, parent=parent, joint=joint, mass=mass, com=tuple(com), inertia=inertia,
+                  coordinate=j.name)
+    for pname, spec in (contact_points or {}).items():
+        try:
+            lk, at = spec
+        except (TypeError, ValueError):
+            raise ModelError(f"contact point {pname!r}: give (link, (x, y, z)), got {spec!r}") from None
+        if lk == base and base_joint is None:
+            raise ModelError(f"contact point {pname!r} is on the base link {base!r}, which does not move")
+        tree.point(pname, lk, at)
+    return model
