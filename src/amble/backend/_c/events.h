@@ -39,16 +39,33 @@ static int surf_enabled(int mode, int k, double t, const double *x, const double
     return enabled(MODE_TR0[mode] + k, t, x, p);
 }
 
-/* A guard exactly zero where a mode is entered (after a reset, at the start) cannot be seen
- * crossing from its pre-crossing side: if ġ there points across it in its direction, the
- * crossing is genuine and the guard is placed on the pre-crossing side by the smallest amount.
- * `fired`: index within the mode of a transition that just fired into its own mode, which is
- * left alone (it sits on its own root). */
-static void arm_zero_guards(int mode, double *g, const double *gd, int fired) {
+/* A guard zero where a mode is entered (after a reset, at the start) cannot be seen crossing
+ * from its pre-crossing side. If it is exactly zero and ġ there points across it in its
+ * direction, the crossing is genuine and the guard is placed on the pre-crossing side by the
+ * smallest amount. If it is zero up to round-off with ġ ≈ 0 (a point left at rest on the ground:
+ * restitution 0, or started there), the flow an instant later decides: accelerating across, it
+ * fires again at once (and repeated zero-time events end the run as zeno) instead of sinking
+ * through unseen. `fired`: index within the mode of a transition that has just fired into its
+ * own mode; it sits on its own root and only the second test applies to it. */
+static void arm_zero_guards(int mode, double t, const double *x, const double *f, const double *p, int n,
+                            double *g, const double *gd, int fired) {
+    double scale = 1.0;
+    for (int i = 0; i < n; ++i) scale = fmax(scale, fabs(x[i]));
     for (int k = 0; k < MODE_NTR[mode]; ++k) {
-        if (k == fired || g[k] != 0.0 || gd[k] == 0.0) continue; /* not the guard that just fired */
-        int dir = surf_dir(mode, k);
-        if (dir == 0 || (dir < 0) == (gd[k] < 0.0)) g[k] = gd[k] < 0.0 ? DBL_MIN : -DBL_MIN;
+        const int dir = TR_DIR[MODE_TR0[mode] + k];
+        if (fabs(gd[k]) > 1e-12 * scale) {
+            if (k == fired || g[k] != 0.0) continue;
+            if (dir == 0 || (dir < 0) == (gd[k] < 0.0)) g[k] = gd[k] < 0.0 ? DBL_MIN : -DBL_MIN;
+            continue;
+        }
+        if (fabs(g[k]) > 1e-12 * scale) continue;
+        double x1[NXMAX], f1[NXMAX], g1[NTR1];
+        const double dt = 1.5e-8 * fmax(1.0, fabs(t));
+        for (int i = 0; i < n; ++i) x1[i] = x[i] + dt * f[i];
+        if (rhs(mode, t + dt, x1, p, f1)) continue;
+        surfaces_dot(mode, t + dt, x1, f1, p, g1);
+        if (g1[k] == 0.0) continue;
+        if (dir == 0 || (dir < 0) == (g1[k] < 0.0)) g[k] = g1[k] < 0.0 ? DBL_MIN : -DBL_MIN;
     }
 }
 

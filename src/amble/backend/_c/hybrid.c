@@ -68,7 +68,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     double g_old[NTR1], gd_old[NTR1], gd_new[NTR1];
     surfaces(mode, t, s.y_old, p, g_old);
     surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
-    arm_zero_guards(mode, g_old, gd_old, -1);
+    arm_zero_guards(mode, t, s.y_old, s.f_old, p, s.n, g_old, gd_old, -1);
     int status = -1, zs;
     if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
         ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
@@ -202,7 +202,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
         surfaces(mode, t, s.y_old, p, g_old);
         surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
-        arm_zero_guards(mode, g_old, gd_old, fired);
+        arm_zero_guards(mode, t, s.y_old, s.f_old, p, s.n, g_old, gd_old, fired);
         if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
             ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
             status = ST_SLIDING;
