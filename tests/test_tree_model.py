@@ -206,3 +206,16 @@ def test_point_mass_on_a_tree_point_adds_to_the_body():
     assert M[0, 0] == pytest.approx(2.0 * 0.09 + 0.05 + 0.36, rel=1e-14)
     assert h[0] == pytest.approx(G * (0.6 + 0.6) * np.sin(0.4), rel=1e-13)
     assert float(eq.G[0].subs(m.q[0], 0.4)) == pytest.approx(h[0], rel=1e-13)
+
+
+def test_structure_text_is_canonical_and_linear_in_shared_parts():
+    from amble.modelling.geometry import dag_srepr
+
+    x, y = sp.symbols("x y")
+    a = sp.Add(sp.sin(x), y, evaluate=False)
+    deep = a
+    for _ in range(40):  # 2⁴⁰ paths through the shared parts: sympy.srepr would not finish
+        deep = sp.Mul(deep, sp.Add(deep, 1, evaluate=False), evaluate=False)
+    assert len(dag_srepr([deep])) < 10_000
+    assert dag_srepr([sp.sin(x) + y]) == dag_srepr([y + sp.sin(x)])
+    assert dag_srepr([sp.sin(x) + y]) != dag_srepr([sp.cos(x) + y])
