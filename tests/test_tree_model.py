@@ -190,3 +190,32 @@ def test_urdf_walker_steps_with_a_derived_impact():
     e = k.energy_rows(np.zeros(2), np.zeros(2, dtype=np.int64), np.array([ev.x_pre, ev.x_post]), np.zeros(1))
     assert e[1, 0] < e[0, 0]  # a plastic impact loses kinetic energy
     assert e[1, 1] == pytest.approx(e[0, 1], rel=1e-12)  # the relabelling keeps the pose
+
+
+def test_point_mass_on_a_tree_point_adds_to_the_body():
+    # a 1 kg point mass at the tip of a compound pendulum: M = m c² + I_yy + m_tip l², h = g (m c + m_tip l) sin q
+    m = Model("pendulum_tip", dims=3)
+    m.gravity(G)
+    T = m.rigid_tree()
+    T.body("arm", joint=Joint("revolute", axis=(0, 1, 0)), mass=2.0, com=(0, 0, -0.3),
+           inertia=np.diag([0.04, 0.05, 0.01]))
+    T.point("tip", "arm", (0, 0, -0.6))
+    m.mass("tip", 1.0)
+    eq = derive(m)
+    M, h = _numeric(eq, m, [0.4], [0.7])
+    assert M[0, 0] == pytest.approx(2.0 * 0.09 + 0.05 + 0.36, rel=1e-14)
+    assert h[0] == pytest.approx(G * (0.6 + 0.6) * np.sin(0.4), rel=1e-13)
+    assert float(eq.G[0].subs(m.q[0], 0.4)) == pytest.approx(h[0], rel=1e-13)
+
+
+def test_structure_text_is_canonical_and_linear_in_shared_parts():
+    from amble.modelling.geometry import dag_srepr
+
+    x, y = sp.symbols("x y")
+    a = sp.Add(sp.sin(x), y, evaluate=False)
+    deep = a
+    for _ in range(40):  # 2⁴⁰ paths through the shared parts: sympy.srepr would not finish
+        deep = sp.Mul(deep, sp.Add(deep, 1, evaluate=False), evaluate=False)
+    assert len(dag_srepr([deep])) < 10_000
+    assert dag_srepr([sp.sin(x) + y]) == dag_srepr([y + sp.sin(x)])
+    assert dag_srepr([sp.sin(x) + y]) != dag_srepr([sp.cos(x) + y])

@@ -50,9 +50,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import sympy as sp
-
 from ..errors import CompileError
+from ..modelling.geometry import dag_srepr
 from ..modelling.hybrid import HybridSystem
 from ..version import __version__
 
@@ -179,11 +178,11 @@ def _structure_digest(system: HybridSystem) -> str:
         parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]
         parts += [m._k_terms, m._v_terms, m._k_override, m._v_override, m._l_override]
         parts += [m._forces, m.gravity_vector]
-        h.update(sp.srepr(parts).encode())
+        h.update(dag_srepr(parts).encode())
     for tr in system.transitions:
         h.update(repr((tr.name, tr.source, tr.target, tr.terminal, tr.step)).encode())
-        h.update(sp.srepr([tr.guard.expr, tr.guard.direction, tr.guard.enabled]).encode())
-        h.update(sp.srepr(_reset_repr(tr.reset)).encode())
+        h.update(dag_srepr([tr.guard.expr, tr.guard.direction, tr.guard.enabled]).encode())
+        h.update(dag_srepr(_reset_repr(tr.reset)).encode())
     h.update(repr(list(system.parameters)).encode())
     return h.hexdigest()
 

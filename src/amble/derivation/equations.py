@@ -58,7 +58,7 @@ class Equations:
     def G(self) -> sp.Matrix:
         """Gravity (potential) term ``∂V/∂q``; with ``L`` given outright, ``h`` at ``q̇ = 0``."""
         if self.V is not None:
-            return sp.Matrix([sp.diff(self.V, qi) for qi in self.q])
+            return sp.Matrix([self.model.diff(self.V, qi) for qi in self.q])
         return self.h.subs({v: 0 for v in self.qd})
 
     @property
@@ -185,7 +185,7 @@ def derive(model: Model) -> Equations:
                 _add_lagrangian_terms(extra, q, qd, M, h)
         V = _potential_outside_tree(model) if model._k_override is None else model.V
         for i in range(n):
-            h[i] += sp.diff(V, q[i])
+            h[i] += model.diff(V, q[i])
     K = None if given_l else model.K
     V = None if given_l else model.V
     if given_l:
@@ -211,13 +211,13 @@ def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:
         if model.tree is not None and name in model.tree.com_points:
             continue  # the tree's bodies are in tree_dynamics
         pos = model.points[name]
-        J = pos.jacobian(q)
+        J = model.jacobian(pos)
         if t in pos.free_symbols:
             raise ModelError(f"model {model.name!r}: point mass {name!r} moves explicitly with t")
         v = J * qd_vec
         a = sp.zeros(pos.rows, 1)
         for k in range(n):
-            dv = v.diff(q[k])
+            dv = v.applyfunc(lambda e, qk=q[k]: model.diff(e, qk))
             if any(e != 0 for e in dv):
                 a += dv * qd[k]
         for i in range(n):

@@ -106,3 +106,44 @@ def dag_diff(expr: Any, x: sp.Symbol, memo: dict | None = None) -> sp.Expr:
         memo[e] = out
         stack.pop()
     return memo[sp.sympify(expr)]
+
+
+def dag_srepr(obj: Any) -> str:
+    """A canonical text of expressions (in lists, tuples, dicts or matrices) that writes each
+    distinct subexpression once and refers to it by number afterwards — linear in the size of a
+    DAG, where ``sympy.srepr`` writes shared parts out at every use."""
+    table: dict[sp.Basic, int] = {}
+    out: list[str] = []
+
+    def node(e: sp.Basic) -> int:
+        stack = [e]
+        while stack:
+            x = stack[-1]
+            if x in table:
+                stack.pop()
+                continue
+            if x.is_Atom:
+                out.append(sp.srepr(x))
+            else:
+                todo = [a for a in x.args if a not in table]
+                if todo:
+                    stack.extend(todo)
+                    continue
+                out.append(f"{type(x).__name__}({','.join(str(table[a]) for a in x.args)})")
+            table[x] = len(table)
+            stack.pop()
+        return table[e]
+
+    def walk(o: Any) -> str:
+        if isinstance(o, sp.MatrixBase):
+            return "M" + repr(o.shape) + "[" + ",".join(walk(e) for e in o) + "]"
+        if isinstance(o, sp.Basic):
+            return f"#{node(o)}"
+        if isinstance(o, (list, tuple)):
+            return "(" + ",".join(walk(e) for e in o) + ")"
+        if isinstance(o, dict):
+            return "{" + ",".join(f"{walk(k)}:{walk(v)}" for k, v in o.items()) + "}"
+        return repr(o)
+
+    top = walk(obj)
+    return top + "|" + ";".join(out)
