@@ -126,3 +126,35 @@ def test_viewer_of_a_plain_system_shows_no_ground_slope_or_step(pendulum, compas
     assert "slope" not in subtitle and "frames" in subtitle and "step" not in labels
     subtitle, labels = dom(amble.simulate(compass, steps=2), "walker")
     assert "slope 2.86°" in subtitle and labels.startswith("step ")
+
+
+@pytest.mark.browser
+def test_viewer_time_series_panel_follows_the_playhead(compass, pendulum, tmp_path):
+    import re
+    import shutil
+    import subprocess
+
+    chromium = shutil.which("chromium")
+    if chromium is None:
+        pytest.skip("headless Chromium not found (apt-get install chromium)")
+    walk = amble.simulate(compass, steps=2)
+
+    def panel(path, t):
+        proc = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
+                               "--disable-dev-shm-usage", f"--user-data-dir={tmp_path / f'p{t}'}",
+                               "--virtual-time-budget=1000", "--dump-dom", path.as_uri() + f"#t={t}"],
+                              capture_output=True, text=True, timeout=60)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        return re.search(r"<canvas[^>]*id=\"series\"[^>]*>", proc.stdout).group(0)
+
+    path = amble.animate(walk, tmp_path / "walk.html", fps=30)
+    for t in (0.25, 1.0):
+        tag = panel(path, t)
+        assert "hidden" not in tag and 'data-series="stance,swing,energy"' in tag, tag
+        assert f'data-playhead="{t:.3f}"' in tag, tag
+    scene = scene_of(walk, fps=30, series=["swing_dot"])
+    assert list(scene["series"]) == ["swing_dot"] and len(scene["series"]["swing_dot"]) == len(scene["times"])
+    bare = amble.animate(pendulum, tmp_path / "bare.html", fps=30, series=[])
+    assert "hidden" in panel(bare, 0.5)
+    with pytest.raises(amble.viz.errors.SceneError, match="unknown column"):
+        scene_of(walk, series=["nope"])

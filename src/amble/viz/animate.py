@@ -50,8 +50,29 @@ def _slope(system: HybridSystem, params: dict[str, float]) -> float:
     return system.slope_value(params) if isinstance(system, Walker) else 0.0
 
 
-def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = None) -> dict:
-    """Scene JSON (see :func:`amble.viz.scene.frames`) of a trajectory in world coordinates."""
+def series_of(traj: Trajectory, times: np.ndarray, names: Sequence[str] | None) -> dict[str, np.ndarray]:
+    """Values at ``times`` of state variables by name and ``"energy"`` (total), for the viewer's
+    panel; default: the coordinates of the first mode and the energy."""
+    if names is None:
+        names = [*(str(q) for q in traj.system.modes[traj.mode_names[0]].q), "energy"]
+    table = traj.table()
+    out = {}
+    for name in names:
+        if name == "energy":
+            col = table["kinetic_energy"] + table["potential_energy"]
+        elif name in table and name not in ("t", "mode"):
+            col = np.asarray(table[name], float)
+        else:
+            raise SceneError(f"series: unknown column {name!r}; known: {', '.join(list(table)[2:])}, energy")
+        idx = np.clip(np.searchsorted(traj.t, times, side="right") - 1, 0, len(traj.t) - 1)
+        out[name] = col[idx]  # the last sample at or before each frame
+    return out
+
+
+def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = None,
+             series: Sequence[str] | None = None) -> dict:
+    """Scene JSON (see :func:`amble.viz.scene.frames`) of a trajectory in world coordinates, with
+    a time-series panel of ``series`` (see :func:`series_of`; ``[]`` for none)."""
     system = traj.system
     times, pts = traj.resample(fps)
     shapes = look_of(system, traj.parameters, look)
@@ -63,23 +84,25 @@ def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = N
     labels = {}
     if walker:  # a step count means something for a walker only
         labels["step"] = np.searchsorted([e.t for e in traj.step_events], times, side="right").tolist()
-    return frames(shapes, pts, times, follow=follow, labels=labels)
+    return frames(shapes, pts, times, follow=follow, labels=labels, series=series_of(traj, times, series))
 
 
 def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None,
-            progress: bool | None = None) -> Path:
+            progress: bool | None = None, series: Sequence[str] | None = None) -> Path:
     """Write an animation of ``traj``: ``.html`` (3D, offline, interactive), ``.gif`` or ``.mp4``.
 
     ``look``: the shapes to draw (:mod:`amble.viz.scene`); default: made from the model. A movie
     plays in the trajectory's time with a clock, at most 30 fps (a GIF at a rate whose frames last
     whole hundredths of a second: 25 fps for 30); ``progress``: a progress bar while a movie is
-    written (default: when stderr is a terminal). See :mod:`amble.viz.movie`."""
+    written (default: when stderr is a terminal). See :mod:`amble.viz.movie`. ``series``: state
+    variables (and ``"energy"``) shown as time series under the 3D view of the ``.html`` viewer,
+    with a playhead (default: the coordinates and the energy; ``[]`` for no panel)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".html":
         from .html import write_html
 
-        return write_html(path, scene_of(traj, fps, look), title=f"amble — {traj.system.name}")
+        return write_html(path, scene_of(traj, fps, look, series), title=f"amble — {traj.system.name}")
     if suffix in (".gif", ".mp4"):
         from .movie import check_writer, write_movie
 

@@ -24,6 +24,7 @@ def frames(
     *,
     follow: str | None = None,
     labels: Mapping[str, Sequence[Any]] | None = None,
+    series: Mapping[str, Sequence[float]] | None = None,
 ) -> dict[str, Any]:
     """Build the JSON-serialisable scene the viewer animates.
 
@@ -37,6 +38,8 @@ def frames(
         follow: a point name the camera can track, typically the hip.
         labels: extra per-frame values shown next to the clock, e.g.
             ``{"step": step_index}``; each a sequence of ``F`` numbers or strings.
+        series: time series drawn in the viewer's panel with a playhead, e.g.
+            ``{"stance": values, "energy": values}``; each ``F`` numbers.
 
     Returns:
         The scene dictionary described in :mod:`amble.viz.scene`.
@@ -99,6 +102,7 @@ def frames(
         "shapes": shape_dicts,
         "follow": follow,
         "labels": _labels(labels, n),
+        **({"series": _series(series, n)} if series else {}),
         "bounds": {"min": _flat(lo), "max": _flat(hi)},
     }
     return scene
@@ -125,6 +129,17 @@ def _ground_extent(slope: float, x_min: float, x_max: float) -> tuple[float, flo
     c = math.cos(slope)
     # The along-slope coordinate s of a point at x is x / cos(slope).
     return ((x_min - margin) / c, (x_max + margin) / c)
+
+
+def _series(series: Mapping[str, Sequence[float]], n: int) -> dict[str, list[Any]]:
+    """Time series for the viewer's panel: ``F`` numbers each (non-finite → null)."""
+    out: dict[str, list[Any]] = {}
+    for key, values in series.items():
+        vals = np.asarray(values, dtype=float)
+        if vals.shape != (n,):
+            raise SceneError(f"frames: series {key!r} has shape {vals.shape}, times has {n}")
+        out[str(key)] = [rounded(float(v)) if math.isfinite(v) else None for v in vals]
+    return out
 
 
 def _labels(labels: Mapping[str, Sequence[Any]] | None, n: int) -> dict[str, list[Any]]:

@@ -42,7 +42,7 @@ from .scene import FORMAT
 __all__ = ["render_html", "write_html"]
 
 #: The viewer's parts of one function body, joined in this order (see viewer/data.js).
-_VIEWER_PARTS = ("data.js", "scene.js", "player.js")
+_VIEWER_PARTS = ("data.js", "scene.js", "series.js", "player.js")
 
 
 def _read(*path: str) -> str:

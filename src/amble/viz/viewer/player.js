@@ -34,6 +34,7 @@
     const parts = [];
     for (const key in labels) parts.push(key + ' ' + fmtLabel(labels[key][k]));
     labelBox.textContent = parts.join('  ·  ');
+    drawSeries(time);
   }
 
   function resize() {
@@ -106,7 +107,8 @@
     else if (e.code === 'ArrowRight') { e.preventDefault(); stepFrame(1); }
     else if (e.code === 'ArrowLeft') { e.preventDefault(); stepFrame(-1); }
   });
-  window.addEventListener('resize', () => { resize(); draw(); });
+  buildSeries();
+  window.addEventListener('resize', () => { resize(); buildSeries(); draw(); });
 
   // ---- subtitle -------------------------------------------------------------------
   const sub = [];
