@@ -6,8 +6,7 @@ into the current directory.
 
 from amble import simulate
 from amble.models import load
-from amble.viz import animate
-from amble.viz import plot_trajectory
+from amble.viz import animate, plot_trajectory
 
 walker = load("compass-gait")
 # Start near the thesis' gait (state: stance, swing, stance_dot, swing_dot in rad, rad/s).
