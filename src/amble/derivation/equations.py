@@ -14,6 +14,7 @@ polynomially with the number of coordinates (see :meth:`Equations.count_ops`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import sympy as sp
 
@@ -94,13 +95,18 @@ class Equations:
         return self.latex(display=True)
 
 
-TIDY_OPS = 150  # entries up to this many operations are tidied for display (trigsimp)
+TIDY_OPS = 60  # entries up to this many operations are tidied for display (trigsimp costs seconds beyond)
 
 
 def tidy(expr: sp.Expr) -> sp.Expr:
     """An entry as displayed: small ones tidied with ``trigsimp`` (``sin² + cos²`` → 1), large ones
     as derived. Display only — the compiled code is generated from the unexpanded expressions."""
-    expr = sp.sympify(expr)
+    return _tidy(sp.sympify(expr))
+
+
+@lru_cache(maxsize=4096)
+def _tidy(expr: sp.Expr) -> sp.Expr:
+    # cached: the same entries recur across modes and in the impact maps (M inside M_e)
     return sp.trigsimp(expr) if sp.count_ops(expr) <= TIDY_OPS else expr
 
 
