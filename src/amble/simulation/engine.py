@@ -10,12 +10,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from ..backend.abi import CODE, CTX, CTX_X, IOPT_FIELDS, OPT_FIELDS, OUTCOME
+from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME
 from ..backend.kernels import Kernels
+
+#: Accepted integrator steps per compiled call: the loop returns this often so that Python can
+#: handle signals (Ctrl-C), then resumes exactly where it stopped.
+YIELD_STEPS = 20_000
+
+_CX_T, _CX_MODE, _CX_TLAST_STEP, _CX_GRID_T0 = CTX["T"], CTX["MODE"], CTX["TLAST_STEP"], CTX["GRID_T0"]
+_CX_TPREV_EVENT, _CX_FRESH = CTX["TPREV_EVENT"], CTX["FRESH"]
+_OP_TEND, _OP_SAMPLEDT = OPT["TEND"], OPT["SAMPLEDT"]
+_IO_MAXSTEPS, _IO_OUTCAP, _IO_EVCAP = IOPT["MAXSTEPS"], IOPT["OUTCAP"], IOPT["EVCAP"]
 
 
 @dataclass(frozen=True)
@@ -44,13 +54,29 @@ class Options:
     max_integrator_steps: int = 20_000_000
     max_steps_between_events: int = 1_000_000
 
+    @cached_property
+    def _opt(self) -> np.ndarray:
+        """``opt`` laid out by the table, with the per-run fields (end time, sampling) at 0."""
+        values = {"TEND": 0.0, "RTOL": self.rtol, "ATOL": self.atol, "MAXSTEP": self.max_step,
+                  "MAXSTEPTIME": self.max_step_time, "SAMPLEDT": 0.0, "ZENODT": self.zeno_dt}
+        return np.array([values[f] for f in OPT_FIELDS], dtype=float)
 
-@dataclass(frozen=True)
+    @cached_property
+    def _iopt(self) -> np.ndarray:
+        """``iopt`` laid out by the table, with the per-run fields (steps, capacities) at 0."""
+        values = {"MAXSTEPS": 0, "MAXEVENTS": self.max_events, "OUTCAP": 0, "EVCAP": 0, "ZENON": self.zeno_events,
+                  "NSUB": self.nsub, "MAXISTEPS": self.max_integrator_steps,
+                  "MAXISTEPS_EV": self.max_steps_between_events, "YIELDN": YIELD_STEPS}
+        return np.array([values[f] for f in IOPT_FIELDS], dtype=np.int64)
+
+
+@dataclass(slots=True)
 class Run:
     """Where a run ended: ``code`` (an :data:`amble.backend.abi.STATUS` code), ``status`` (its
     outcome name; a terminal transition's own status, e.g. ``fell``), time ``t`` (s), ``mode``
     index, state ``x`` (that mode's length), ``steps`` and ``events`` counted, ``info`` (index of
-    the transition that ended it, or −1), the raw ``ctx`` and the ``recorded`` buffers."""
+    the transition that ended it, or −1), the raw ``ctx`` and the ``recorded`` buffers (empty when
+    the run recorded nothing)."""
 
     code: int
     status: str
@@ -92,23 +118,22 @@ def run(
     """Run from ``x0`` in mode ``mode`` at ``t0`` until ``t_end`` (s), ``steps`` step transitions
     (0: no limit) or another end; record samples (every ``sample_dt`` s, 0: every integration step)
     and events when ``record``."""
+    # Called once per return-map evaluation (tens of µs of compiled work): the arrays are laid
+    # out from templates and index constants, not rebuilt field by field.
     nxm = k.nx_max
     ctx = np.zeros(CTX_X + nxm)
-    ctx[CTX["T"]], ctx[CTX["MODE"]], ctx[CTX["TLAST_STEP"]], ctx[CTX["GRID_T0"]] = t0, mode, t0, t0
-    ctx[CTX["TPREV_EVENT"]], ctx[CTX["FRESH"]] = -math.inf, 1.0
+    ctx[_CX_T], ctx[_CX_MODE], ctx[_CX_TLAST_STEP], ctx[_CX_GRID_T0] = t0, mode, t0, t0
+    ctx[_CX_TPREV_EVENT], ctx[_CX_FRESH] = -math.inf, 1.0
     ctx[CTX_X : CTX_X + x0.size] = x0
-    opt_values = {"TEND": t_end, "RTOL": opts.rtol, "ATOL": opts.atol, "MAXSTEP": opts.max_step,
-                  "MAXSTEPTIME": opts.max_step_time, "SAMPLEDT": sample_dt if record else 0.0, "ZENODT": opts.zeno_dt}
-    opt = np.array([opt_values[f] for f in OPT_FIELDS], dtype=float)
-    cap, ecap = (1024, 64) if record else (0, 0)
-    buf = _Buffers(cap, ecap, nxm)
+    opt = opts._opt.copy()
+    opt[_OP_TEND], opt[_OP_SAMPLEDT] = t_end, sample_dt if record else 0.0
+    iopt = opts._iopt.copy()
+    iopt[_IO_MAXSTEPS] = steps
+    buf = _Buffers(1024, 64, nxm) if record else _NO_RECORDING
     code = CODE["YIELD"]
     try:
         while True:
-            iopt_values = {"MAXSTEPS": steps, "MAXEVENTS": opts.max_events, "OUTCAP": buf.cap, "EVCAP": buf.ecap,
-                           "ZENON": opts.zeno_events, "NSUB": opts.nsub, "MAXISTEPS": opts.max_integrator_steps,
-                           "MAXISTEPS_EV": opts.max_steps_between_events, "YIELDN": YIELD_STEPS}
-            iopt = np.array([iopt_values[f] for f in IOPT_FIELDS], dtype=np.int64)
+            iopt[_IO_OUTCAP], iopt[_IO_EVCAP] = buf.cap, buf.ecap
             code = buf.call(k, p, ctx, opt, iopt)
             if code == CODE["BUFFER_FULL"]:
                 buf.grow()
@@ -119,11 +144,6 @@ def run(
         exc.run = _result(k, CODE["YIELD"], ctx, buf)  # type: ignore[attr-defined]
         raise
     return _result(k, code, ctx, buf)
-
-
-#: Accepted integrator steps per compiled call: the loop returns this often so that Python can
-#: handle signals (Ctrl-C), then resumes exactly where it stopped.
-YIELD_STEPS = 20_000
 
 
 def _result(k: Kernels, code: int, ctx: np.ndarray, buf: _Buffers) -> Run:
@@ -148,10 +168,13 @@ class _Buffers:
         self.n = np.zeros(1, dtype=np.int64)
         self.ne = np.zeros(1, dtype=np.int64)
 
+    def addresses(self) -> tuple[int, ...]:
+        return tuple(a.ctypes.data for a in (self.t, self.mode, self.x, self.n, self.et, self.etr, self.epre,
+                                             self.epost, self.ne))
+
     def call(self, k: Kernels, p, ctx, opt, iopt) -> int:
-        arrays = (p, ctx, opt, iopt, self.t, self.mode, self.x, self.n, self.et, self.etr, self.epre, self.epost,
-                  self.ne)
-        return int(k.simulate_raw(*[a.ctypes.data for a in arrays]))
+        out = self._addresses if self is _NO_RECORDING else self.addresses()
+        return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *out))
 
     def grow(self) -> None:
         if self.cap == 0 and self.ecap == 0:
@@ -171,9 +194,18 @@ class _Buffers:
             setattr(self, name, new)
 
     def result(self) -> dict[str, Any]:
+        if self is _NO_RECORDING:
+            return _EMPTY
         n, ne = int(self.n[0]), int(self.ne[0])
         return {"t": self.t[:n].copy(), "mode": self.mode[:n].copy(), "x": self.x[:n].copy(),
                 "et": self.et[:ne].copy(), "etr": self.etr[:ne].copy(), "epre": self.epre[:ne].copy(),
                 "epost": self.epost[:ne].copy()}
 
 
+
+
+#: Buffers of every run that records nothing, shared: with both capacities 0 the compiled loop
+#: writes no row, no event and no counter into them, so runs in several threads may share them.
+_NO_RECORDING = _Buffers(0, 0, 1)
+_NO_RECORDING._addresses = _NO_RECORDING.addresses()  # type: ignore[attr-defined]
+_EMPTY: dict[str, Any] = {}
