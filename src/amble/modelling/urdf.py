@@ -38,7 +38,7 @@ def _read(path: Path) -> Any:
     try:
         import yourdfpy
     except ImportError as e:  # pragma: no cover - a declared dependency
-        raise ModelError("URDF import needs the 'yourdfpy' package (pip install yourdfpy)") from e
+        raise ModelError("URDF import needs the 'yourdfpy' package: pip install 'amble[urdf]'") from e
     try:
         return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
                                   build_collision_scene_graph=False, load_collision_meshes=False)
