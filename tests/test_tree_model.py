@@ -209,7 +209,7 @@ def test_point_mass_on_a_tree_point_adds_to_the_body():
 
 
 def test_structure_text_is_canonical_and_linear_in_shared_parts():
-    from amble.modelling.geometry import dag_srepr
+    from amble.modelling.dag import dag_srepr
 
     x, y = sp.symbols("x y")
     a = sp.Add(sp.sin(x), y, evaluate=False)

@@ -6,7 +6,7 @@ The key is a hash of everything that shapes the compiled library:
 * the system's *structure* — symbolic positions, masses, energies, forces, guards and resets,
   parameter names — but never parameter values or defaults, which are run-time inputs;
 * the sources that generate and compile it: the C engine (``backend/_c``), the backend, the
-  derivation, and the modelling types that feed them (``modelling/{model,hybrid,walker}.py``),
+  derivation, and the modelling layer that feeds them (``modelling/*.py``: trees, DAG tools),
   and the amble version;
 * the toolchain: ``$CC`` (or the compiler found), its ``--version`` output, and ``$AMBLE_CFLAGS``.
 
@@ -51,7 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CompileError
-from ..modelling.geometry import dag_srepr
+from ..modelling.dag import dag_srepr
 from ..modelling.hybrid import HybridSystem
 from ..version import __version__
 
@@ -59,8 +59,7 @@ C_DIR = Path(str(resources.files("amble.backend") / "_c"))
 _PKG = Path(__file__).resolve().parents[1]
 
 #: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.
-_SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/model.py", "modelling/hybrid.py",
-                 "modelling/walker.py")
+_SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/*.py")
 
 #: id(system) → (weak reference, fingerprint, structural hash)
 _STRUCT: dict[int, tuple[weakref.ref, tuple, str]] = {}

@@ -24,9 +24,10 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
+from .dag import dag_diff, free_symbols
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
-from .geometry import dag_diff, free_symbols, t
+from .geometry import t
 from .names import Names
 from .tree import RigidTree
 
