@@ -187,7 +187,7 @@ def default_guess(system: HybridSystem, params: Mapping[str, float] | None = Non
     start = system.fixed_point_guess
     if start is None and not system.default_start:
         raise ConvergenceError(f"system {system.name!r} has neither a fixed-point guess nor a default start")
-    tr = simulate(system, start, params=params, steps=steps, sample_dt=0.0)
+    tr = simulate(system, start, params=params, steps=steps, samples=False)  # events only: bounded memory
     post = tr.final_post_impact_state
     if tr.status == "completed" and post is not None:
         return post

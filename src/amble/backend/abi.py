@@ -30,6 +30,7 @@ STATUS: tuple[tuple[int, str, str | None], ...] = (
     (12, "MAX_ISTEPS", "max_integrator_steps"),     # integrator steps of the whole run exhausted
     (13, "YIELD", None),                            # periodic return to Python (signals), then resume
     (14, "SLIDING", "sliding"),                     # the flow points into a switching surface from both sides
+    (15, "RECORD_LIMIT", "record_limit"),           # set by Python: the recording budget is spent
 )
 
 #: Fields of ``ctx`` (float64), the resumable state of a run, in index order; the state vector

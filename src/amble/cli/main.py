@@ -79,8 +79,9 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
+    # samples are recorded only for an output that shows them: a summary needs the events alone
     tr = simulate(s, x0, params=params, steps=steps, t_end=args.time, rtol=args.rtol, atol=args.atol,
-                  sample_dt=1.0 / 200)
+                  sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p))
     summary = tr.summary()
     if out_p:
         tr.save(out_p)

@@ -41,6 +41,8 @@ class Walker(HybridSystem):
     hip: str | None = None
     slope: Any = 0.0
     mirror: str | None = None
+    #: a walker without a footfall for this long has fallen (s; 5 s unless the model says otherwise)
+    max_step_time: float = 5.0
 
     def __post_init__(self) -> None:
         super().__post_init__()

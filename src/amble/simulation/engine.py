@@ -18,6 +18,9 @@ import numpy as np
 from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME
 from ..backend.kernels import Kernels
 
+#: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB.
+RECORD_BUDGET = 512 * 2**20
+
 #: Accepted integrator steps per compiled call: the loop returns this often so that Python can
 #: handle signals (Ctrl-C), then resumes exactly where it stopped.
 YIELD_STEPS = 20_000
@@ -114,10 +117,13 @@ def run(
     opts: Options = Options(),
     sample_dt: float = 0.0,
     record: bool = False,
+    events_only: bool = False,
+    budget: int = RECORD_BUDGET,
 ) -> Run:
     """Run from ``x0`` in mode ``mode`` at ``t0`` until ``t_end`` (s), ``steps`` step transitions
     (0: no limit) or another end; record samples (every ``sample_dt`` s, 0: every integration step)
-    and events when ``record``."""
+    and events when ``record`` (only events with ``events_only``). Recorded buffers never grow
+    past ``budget`` bytes: the run then ends as ``record_limit`` with what it recorded."""
     # Called once per return-map evaluation (tens of µs of compiled work): the arrays are laid
     # out from templates and index constants, not rebuilt field by field.
     nxm = k.nx_max
@@ -129,13 +135,16 @@ def run(
     opt[_OP_TEND], opt[_OP_SAMPLEDT] = t_end, sample_dt if record else 0.0
     iopt = opts._iopt.copy()
     iopt[_IO_MAXSTEPS] = steps
-    buf = _Buffers(1024, 64, nxm) if record else _NO_RECORDING
+    buf = _Buffers(0 if events_only else 1024, 64, nxm) if record else _NO_RECORDING
     code = CODE["YIELD"]
     try:
         while True:
             iopt[_IO_OUTCAP], iopt[_IO_EVCAP] = buf.cap, buf.ecap
             code = buf.call(k, p, ctx, opt, iopt)
             if code == CODE["BUFFER_FULL"]:
+                if buf.nbytes_grown() > budget:  # the run is resumable here: stop with what it has
+                    code = CODE["RECORD_LIMIT"]
+                    break
                 buf.grow()
             elif code != CODE["YIELD"]:
                 break
@@ -175,6 +184,12 @@ class _Buffers:
     def call(self, k: Kernels, p, ctx, opt, iopt) -> int:
         out = self._addresses if self is _NO_RECORDING else self.addresses()
         return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *out))
+
+    def nbytes_grown(self) -> int:
+        """Bytes the buffers would hold after :meth:`grow`."""
+        rows = 2 * self.cap * (8 + 4 + 8 * self.nxm)
+        events = (2 if int(self.ne[0]) >= self.ecap - 1 else 1) * self.ecap * (8 + 4 + 16 * self.nxm)
+        return rows + events
 
     def grow(self) -> None:
         if self.cap == 0 and self.ecap == 0:

@@ -16,7 +16,7 @@ from ..backend.abi import CODE
 from ..backend.kernels import Kernels, build
 from ..errors import ParameterError, StateError
 from ..modelling.hybrid import HybridSystem
-from .engine import Options, Run, run
+from .engine import RECORD_BUDGET, Options, Run, run
 from .trajectory import Event, Trajectory
 
 
@@ -76,6 +76,8 @@ def simulate(
     sample_dt: float = 0.01,
     max_step_time: float | None = None,
     options: Options | None = None,
+    samples: bool = True,
+    budget: int = RECORD_BUDGET,
 ) -> Trajectory:
     """Simulate a hybrid system and return its :class:`Trajectory`.
 
@@ -93,14 +95,22 @@ def simulate(
         Output grid spacing (s); ``0`` records every integration step instead.
     max_step_time:
         A walker with no footfall for this long has fallen (s); default from the system.
+    samples:
+        ``False``: record events only (the trajectory's rows are then the initial and the final
+        state) — constant memory however long the run.
+    budget:
+        Bytes the recording may take (default 512 MiB); a run that would record more ends as
+        ``record_limit`` with what it has.
     """
     k = build(system)
     p = parameter_vector(k, params, system)
     mi, x = initial_state(system, k, x0, mode)
     if steps is not None and steps < 1:
         raise StateError(f"steps must be at least 1, got {steps}")
-    if t_end is not None and not (t_end > 0):
-        raise StateError(f"end time must be positive, got {t_end}")
+    if t_end is not None and not (t_end > 0 and math.isfinite(t_end)):
+        raise StateError(f"end time must be positive and finite, got {t_end}")
+    if not (sample_dt >= 0 and math.isfinite(sample_dt)):
+        raise StateError(f"sample_dt must be a finite number ≥ 0 s, got {sample_dt}")
     if steps is None and t_end is None:
         t_end = 10.0
     base = options or Options()
@@ -113,7 +123,7 @@ def simulate(
     opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=mst)
     try:
         r = run(k, p, mi, x, t_end=t_end if t_end is not None else math.inf, steps=steps or 0, opts=opts,
-                sample_dt=sample_dt, record=True)
+                sample_dt=sample_dt, record=True, events_only=not samples, budget=budget)
     except KeyboardInterrupt as exc:
         partial = getattr(exc, "run", None)
         if partial is not None:  # the run so far, as ``exc.trajectory``
@@ -121,6 +131,13 @@ def simulate(
             exc.trajectory.system = system  # type: ignore[attr-defined]
         raise
     traj = _trajectory(k, p, r, opts)
+    if not samples:  # rows: where the run started and where it ended
+        x_end = np.full(k.nx_max, np.nan)
+        x_end[: r.x.size] = r.x
+        x_start = np.full(k.nx_max, np.nan)
+        x_start[: x.size] = x
+        traj.t, traj.mode = np.array([0.0, r.t]), np.array([mi, r.mode], dtype=np.int32)
+        traj.x = np.vstack([x_start, x_end])
     traj.system = system
     return traj
 
@@ -151,6 +168,8 @@ _MESSAGES = {
     "SINGULAR_MASS": "mass matrix singular or ill-conditioned at t = {t:.9g} s, state {x}",
     "RESET_FAILED": "reset of {transition!r} failed at t = {t:.9g} s",
     "MAX_EVENTS": "{events} events, the most allowed, at t = {t:.6g} s",
+    "RECORD_LIMIT": "recording budget spent at t = {t:.6g} s ({steps} steps): record less often (sample_dt) "
+                    "or nothing (samples=False)",
     "STALLED": "{max_steps_between_events} integrator steps without a transition, the most allowed, at t = {t:.9g} s",
     "MAX_ISTEPS": "{max_integrator_steps} integrator steps, the most allowed, at t = {t:.9g} s",
     "YIELD": "interrupted at t = {t:.9g} s",
