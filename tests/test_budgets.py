@@ -57,3 +57,15 @@ def test_a_long_summary_run_uses_little_memory():
     stats = json.loads(r.stderr.strip().splitlines()[-1])
     assert stats["rc"] == 0 and out["status"] == "completed" and out["steps"] == 100000
     assert stats["kib"] < 200 * 1024, f"peak memory {stats['kib'] / 1024:.0f} MiB"  # was 1.38 GB
+
+
+@pytest.mark.parametrize("args", [["limit-cycle", "compass-gait", "--rtol", "0"],
+                                  ["limit-cycle", "compass-gait", "--rtol", "1", "--atol", "1"],
+                                  ["simulate", "compass-gait", "--rtol", "10", "--atol", "10"],
+                                  ["sweep", "compass-gait", "--param", "slope=0.04:0.05:2", "--rtol", "1e-300",
+                                   "--scheduler", "synchronous"]])
+def test_tolerances_outside_their_domain_are_refused(args, capsys):
+    from amble.cli.main import main
+
+    assert main(args) == 2  # --rtol 1e-300 once hung; --rtol 1 ended in an IndexError
+    assert "must be a number in [1e-16, 1)" in capsys.readouterr().err

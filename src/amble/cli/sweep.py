@@ -20,6 +20,7 @@ from ..analysis.basin import BASIN_LABELS, BasinResult, basin
 from ..analysis.bifurcation import bifurcation, first_period_doubling_iterates
 from ..analysis.defaults import BASIN_STEPS
 from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
+from ..simulation.engine import Options
 from .args import UsageError, load_model, parse_range, parse_sets, writable_path
 
 
@@ -36,6 +37,8 @@ def sweep_cli(args: Any) -> dict[str, Any]:
         v = getattr(args, nm, None)
         if v is not None and not (v > 0 and math.isfinite(v)):
             raise UsageError(f"--{nm} must be a positive number, got {v}")
+        if v is not None:
+            Options(**{nm: v})  # the tolerances' domain, checked once before any work
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be at least 1, got {args.workers}")
     out = writable_path(args.out, (".csv", ".parquet"), "--out")

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME
 from ..backend.kernels import Kernels
+from ..errors import StateError
 
 #: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB.
 RECORD_BUDGET = 512 * 2**20
@@ -56,6 +57,17 @@ class Options:
     nsub: int = 1
     max_integrator_steps: int = 20_000_000
     max_steps_between_events: int = 1_000_000
+
+    def __post_init__(self) -> None:
+        # a tolerance outside (0, 1) asks for no accuracy or for the impossible (rtol 1e-300 never ends)
+        for name in ("rtol", "atol"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and 1e-16 <= v < 1):
+                raise StateError(f"{name} must be a number in [1e-16, 1), got {v!r}")
+        for name in ("max_step", "max_step_time", "zeno_dt"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise StateError(f"{name} must be a finite number ≥ 0, got {v!r}")
 
     @cached_property
     def _opt(self) -> np.ndarray:
