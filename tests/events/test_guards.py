@@ -81,22 +81,17 @@ def test_compass_basin_equals_the_basin_with_an_explicit_margin(tmp_path, n):
     # were "fell" (551 converge, 575 with a 1e-6 m margin); the default margin must flip no cell
     import numpy as np
 
-    from amble import Model, R, walker
+    from amble import walker
     from amble.analysis.basin import basin
     from amble.analysis.poincare import find_fixed_point
+    from amble.models import load
 
-    def compass(margin):
-        m = Model(f"ev-basin-compass-{'default' if margin is None else 'explicit'}")
-        st, sw = m.coordinates("stance swing")
-        mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
-        m.point("stance_foot", (0, 0))
-        hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
-        m.point("stance_mass", b * R(st), mass=ml)
-        m.point("swing_mass", hip - a * R(sw), mass=ml)
-        m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
-        m.gravity(g)
-        return walker(m, foot="swing_foot", hip="hip", slope=slope, relabel={st: sw, sw: st},
-                      start=[-0.2168, 0.3168, 1.0839, 0.3981], margin=margin)
+    def compass(margin):  # the library's compass gait, its footfall with the given margin
+        lib = load("compass-gait")
+        m = lib.modes[lib.mode_names[0]]
+        st, sw = m.q
+        return walker(m, foot="swing_foot", hip="hip", slope=m.symbol("slope"), relabel={st: sw, sw: st},
+                      start=lib.default_start[lib.mode_names[0]], margin=margin)
 
     default, explicit = compass(None), compass(1e-6)
     xs = find_fixed_point(default).fixed_point
