@@ -69,3 +69,17 @@ def test_tolerances_outside_their_domain_are_refused(args, capsys):
 
     assert main(args) == 2  # --rtol 1e-300 once hung; --rtol 1 ended in an IndexError
     assert "must be a number in [1e-16, 1)" in capsys.readouterr().err
+
+
+def test_an_npz_suffix_in_capitals_is_written_where_asked(tmp_path):
+    out = tmp_path / "up.NPZ"
+    amble.simulate(load("compass-gait"), steps=1).save(out)
+    assert out.stat().st_size > 0 and not (tmp_path / "up.NPZ.npz").exists()  # was: empty up.NPZ + up.NPZ.npz
+    assert {"t", "stance", "event_t"} <= set(np.load(out).files)
+
+
+def test_an_empty_field_in_x0_is_an_error_not_dropped(capsys):
+    from amble.cli.main import main
+
+    assert main(["simulate", "compass-gait", "--steps", "1", "--start", "x0=-0.2,,0.3,1,0.3"]) == 2
+    assert "empty value at position 2" in capsys.readouterr().err

@@ -56,8 +56,12 @@ def _start(s, text: str | None, params: dict[str, float]):
 
         return find_fixed_point(s, params=params).fixed_point
     if text.startswith("x0="):
-        vals = [v for v in text[3:].split(",") if v.strip()]
-        return [_float(v, "--start x0") for v in vals]
+        vals = text[3:].split(",")
+        if vals and not vals[-1].strip():
+            vals = vals[:-1]  # a trailing comma is harmless
+        if any(not v.strip() for v in vals):  # an empty field between commas is a missing value
+            raise UsageError(f"x0: empty value at position {[v.strip() for v in vals].index('') + 1} in {text!r}")
+        return [_float(v, "x0") for v in vals]
     raise UsageError(f"--start expects 'fixed-point' or 'x0=V1,V2,...', got {text!r}")
 
 

@@ -184,7 +184,8 @@ class Trajectory:
                 "event_t": np.array([e.t for e in self.events]),
                 "event_name": np.array([e.name for e in self.events]),
             }
-            np.savez(path, **cols, **ev, columns=np.array(list(cols)), units=np.array(units))
+            with path.open("wb") as f:  # a file object: np.savez would append ".npz" to "walk.NPZ"
+                np.savez(f, **cols, **ev, columns=np.array(list(cols)), units=np.array(units))
         elif suffix == ".csv":
             import csv
 
