@@ -5,9 +5,30 @@ subexpression once."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import sympy as sp
+
+
+def fold(root: Any, children: Callable[[Any], Sequence[Any]], combine: Callable[[Any, list[Any]], Any],
+         memo: dict) -> Any:
+    """Post-order fold over a DAG: ``memo[e] = combine(e, [memo[c] for c in children(e)])`` for
+    every node reachable from ``root``, each computed once (iteratively: trees are deep)."""
+    stack = [root]
+    while stack:
+        e = stack[-1]
+        if e in memo:
+            stack.pop()
+            continue
+        kids = children(e)
+        todo = [c for c in kids if c not in memo]
+        if todo:
+            stack.extend(todo)
+            continue
+        memo[e] = combine(e, [memo[c] for c in kids])
+        stack.pop()
+    return memo[root]
 
 
 def free_symbols(expr: Any) -> set[sp.Symbol]:
@@ -35,48 +56,36 @@ def dag_diff(expr: Any, x: sp.Symbol, memo: dict | None = None) -> sp.Expr:
     subexpressions with ``expr``; it is built unevaluated where that keeps sharing."""
     memo = {} if memo is None else memo
     zero = sp.Integer(0)
-    stack = [sp.sympify(expr)]
-    while stack:
-        e = stack[-1]
-        if e in memo:
-            stack.pop()
-            continue
+    rules = (sp.Add, sp.Mul, sp.Pow, sp.sin, sp.cos)
+
+    def children(e: sp.Basic) -> Sequence[sp.Basic]:
+        return e.args if isinstance(e, rules) and not e.is_Atom else ()
+
+    def combine(e: sp.Basic, d: list[sp.Expr]) -> sp.Expr:
         if e.is_Atom:
-            memo[e] = sp.Integer(1) if e == x else zero
-            stack.pop()
-            continue
-        if not isinstance(e, (sp.Add, sp.Mul, sp.Pow, sp.sin, sp.cos)):
-            memo[e] = sp.diff(e, x)
-            stack.pop()
-            continue
-        todo = [a for a in e.args if a not in memo]
-        if todo:
-            stack.extend(todo)
-            continue
-        d = [memo[a] for a in e.args]
+            return sp.Integer(1) if e == x else zero
+        if not isinstance(e, rules):
+            return sp.diff(e, x)
         if isinstance(e, sp.Add):
             terms = [di for di in d if di != 0]
-            out = zero if not terms else terms[0] if len(terms) == 1 else sp.Add(*terms, evaluate=False)
-        elif isinstance(e, sp.Mul):
+            return zero if not terms else terms[0] if len(terms) == 1 else sp.Add(*terms, evaluate=False)
+        if isinstance(e, sp.Mul):
             terms = []
             for i, di in enumerate(d):
                 if di != 0:
                     rest = [a for j, a in enumerate(e.args) if j != i]
                     terms.append(sp.Mul(*rest, di, evaluate=False) if di != 1 else sp.Mul(*rest, evaluate=False))
-            out = zero if not terms else terms[0] if len(terms) == 1 else sp.Add(*terms, evaluate=False)
-        elif isinstance(e, sp.Pow):
+            return zero if not terms else terms[0] if len(terms) == 1 else sp.Add(*terms, evaluate=False)
+        if isinstance(e, sp.Pow):
             b, n = e.args
             if d[1] != 0:
-                out = sp.diff(e, x)
-            else:
-                out = sp.Mul(n, sp.Pow(b, n - 1), d[0], evaluate=False) if d[0] != 0 else zero
-        elif isinstance(e, sp.sin):
-            out = sp.Mul(sp.cos(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
-        else:
-            out = sp.Mul(-1, sp.sin(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
-        memo[e] = out
-        stack.pop()
-    return memo[sp.sympify(expr)]
+                return sp.diff(e, x)
+            return sp.Mul(n, sp.Pow(b, n - 1), d[0], evaluate=False) if d[0] != 0 else zero
+        if isinstance(e, sp.sin):
+            return sp.Mul(sp.cos(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
+        return sp.Mul(-1, sp.sin(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
+
+    return fold(sp.sympify(expr), children, combine, memo)
 
 
 def dag_srepr(obj: Any) -> str:
@@ -86,24 +95,12 @@ def dag_srepr(obj: Any) -> str:
     table: dict[sp.Basic, int] = {}
     out: list[str] = []
 
+    def text(x: sp.Basic, ids: list[int]) -> int:
+        out.append(sp.srepr(x) if x.is_Atom else f"{type(x).__name__}({','.join(map(str, ids))})")
+        return len(table)  # the index it gets, in order of first completion
+
     def node(e: sp.Basic) -> int:
-        stack = [e]
-        while stack:
-            x = stack[-1]
-            if x in table:
-                stack.pop()
-                continue
-            if x.is_Atom:
-                out.append(sp.srepr(x))
-            else:
-                todo = [a for a in x.args if a not in table]
-                if todo:
-                    stack.extend(todo)
-                    continue
-                out.append(f"{type(x).__name__}({','.join(str(table[a]) for a in x.args)})")
-            table[x] = len(table)
-            stack.pop()
-        return table[e]
+        return fold(e, lambda x: () if x.is_Atom else x.args, text, table)
 
     def walk(o: Any) -> str:
         if isinstance(o, sp.MatrixBase):

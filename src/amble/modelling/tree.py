@@ -31,6 +31,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
+from .dag import fold
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
 
@@ -82,36 +83,21 @@ class Defs:
         """``e`` (an expression or matrix of the defined symbols) in q, q̇ and parameters."""
         if isinstance(e, sp.MatrixBase):
             return e.applyfunc(self.expand)
-        done = self._done
-        stack = [sp.sympify(e)]
-        while stack:
-            x = stack[-1]
-            if x in done:
-                stack.pop()
-                continue
-            src = self._defs.get(x, x) if isinstance(x, sp.Dummy) else x
-            if src is not x:
-                if src in done:
-                    done[x] = done[src]
-                    stack.pop()
-                else:
-                    stack.append(src)
-                continue
+        defs = self._defs
+
+        def children(x: sp.Basic) -> Sequence[sp.Basic]:
+            if isinstance(x, sp.Dummy) and x in defs:
+                return (defs[x],)  # a defined symbol stands for its definition
+            return () if x.is_Atom else x.args
+
+        def combine(x: sp.Basic, args: list[Any]) -> Any:
+            if isinstance(x, sp.Dummy) and x in defs:
+                return args[0]
             if x.is_Atom:
-                done[x] = x
-                stack.pop()
-                continue
-            todo = [a for a in x.args if a not in done]
-            if todo:
-                stack.extend(todo)
-                continue
-            args = [done[a] for a in x.args]
-            if isinstance(x, (sp.Add, sp.Mul)):
-                done[x] = x.func(*args, evaluate=False)
-            else:
-                done[x] = x.func(*args)
-            stack.pop()
-        return done[sp.sympify(e)]
+                return x
+            return x.func(*args, evaluate=False) if isinstance(x, (sp.Add, sp.Mul)) else x.func(*args)
+
+        return fold(sp.sympify(e), children, combine, self._done)
 
 
 def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
