@@ -8,8 +8,11 @@ chart it best (pivoted QR) and drop the dependent ones; the return map in those 
 coordinates has a non-singular ``A − I`` at a hyperbolic fixed point, and the eigenvalues of
 ``A`` are the nontrivial Floquet multipliers.
 
-Fixed points are found by damped Newton in the reduced coordinates with a central-difference
-Jacobian (each column one compiled return-map evaluation, ~20–50 µs for the compass gait).
+Fixed points are found by damped Newton in the reduced coordinates with the exact Jacobian of the
+return map: one compiled run carries the variational equations along the flow and the saltation
+matrix through every event (``backend/_c/sensitivity.h``), so the derivative is that of the
+integrated map itself, to its tolerance. Central differences (``jacobian="fd"``) remain as a
+cross-check.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ import numpy as np
 from ..backend.kernels import Kernels, build
 from ..errors import ConvergenceError, ModelError, SimulationError, StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.engine import Options, run
+from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 
@@ -46,6 +49,12 @@ class LimitCycle:
     parameters: dict[str, float]
     jacobian: np.ndarray = field(repr=False)
     hybrid_system: Any = field(default=None, repr=False)
+    #: the k post-impact states of the orbit (the fixed point first) and the k step times (s)
+    orbit: np.ndarray | None = field(default=None, repr=False)
+    step_times: list[float] = field(default_factory=list)
+    #: the period asked for, when the orbit found has a lower one (a period-k search converged to
+    #: a period-d orbit repeated k/d times)
+    requested_period: int | None = None
 
     def trajectory(self, steps: int | None = None) -> Any:
         """Simulate the gait from the fixed point (default: two periods), samples every 5 ms."""
@@ -71,6 +80,9 @@ class LimitCycle:
             "residual": self.residual,
             "iterations": self.iterations,
             "period": self.period,
+            "requested_period": self.requested_period or self.period,
+            "orbit": self.orbit.tolist() if self.orbit is not None else [self.fixed_point.tolist()],
+            "step_times": self.step_times or [self.step_time],
             "parameters": self.parameters,
         }
 
@@ -78,7 +90,10 @@ class LimitCycle:
 #: Longest period a k-step return map is built for.
 MAX_PERIOD = 64
 #: A gait whose points move less than this fraction of the model's size over a period is at rest.
-REST_FRACTION = 1e-6
+#: Not 0: a passive walker on level ground loses a fraction ~θ² of its energy per impact, so a
+#: motion of amplitude θ ≈ 1e-4 has a return-map residual below any tolerance while it decays
+#: towards rest (its largest multiplier is 1 − O(θ²)): such a "fixed point" is not a gait.
+REST_FRACTION = 1e-3
 
 
 class ReturnMap:
@@ -116,6 +131,20 @@ class ReturnMap:
             raise SimulationError("return map: the walker did not come back to the section's mode")
         return r.x, r.t
 
+    def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, float, Sensitivity]:
+        """``P(x)``, the elapsed time and the exact derivatives of both with respect to ``x`` and
+        the parameters (one compiled run with the variational equations)."""
+        r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, sensitivities=True)
+        if not r.completed:
+            raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
+        if r.mode != self.mi:
+            raise SimulationError("return map: the walker did not come back to the section's mode")
+        s = r.sensitivity
+        assert s is not None
+        if not (np.all(np.isfinite(s.dx_dx0)) and np.all(np.isfinite(s.dx_dp))):
+            raise SimulationError("return map: an event grazes its guard (ġ = 0), the map is not differentiable here")
+        return r.x, r.t, s
+
     def last_impact(self, x: np.ndarray) -> tuple[int, float, np.ndarray]:
         """(transition index, time, pre-event state) of the last footfall when mapping ``x``."""
         r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, record=True,
@@ -135,19 +164,9 @@ class ReturnMap:
         k = self.k
         src = k.mode_index(k.meta["transitions"][tr]["source"])
         gi = [j for j, info in enumerate(k.meta["transitions"]) if info["source"] == k.meta["modes"][src]].index(tr)
-        n_pre = xpre.size
-        h = 1e-6
-        grad = np.zeros(n_pre)
-        for j in range(n_pre):
-            e = np.zeros(n_pre)
-            e[j] = h
-            grad[j] = (k.guards(src, t, xpre + e, self.p)[gi] - k.guards(src, t, xpre - e, self.p)[gi]) / (2 * h)
+        grad = k.surface_gradients(src, t, xpre, self.p)[0][gi]
         N = np.linalg.svd(grad[None, :])[2][1:].T  # null space of the guard gradient
-        DR = np.zeros((self.n, n_pre))
-        for j in range(n_pre):
-            e = np.zeros(n_pre)
-            e[j] = h
-            DR[:, j] = (k.reset(tr, t, xpre + e, self.p)[1] - k.reset(tr, t, xpre - e, self.p)[1]) / (2 * h)
+        DR = k.reset_jacobian(tr, t, xpre, self.p)[0]
         T = DR @ N
         U, s, _ = np.linalg.svd(T, full_matrices=False)
         d = int(np.sum(s > 1e-7 * s[0]))
@@ -172,7 +191,12 @@ def _chart(U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return S, E
 
 
-def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, h: float = 1e-5) -> np.ndarray:
+def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, method: str = "exact",
+              h: float = 1e-5) -> np.ndarray:
+    """The return map's Jacobian in chart coordinates: increments ``E ξ`` of the state, the
+    chart coordinates ``S`` of the image."""
+    if method == "exact":
+        return (P.derivatives(x)[2].dx_dx0 @ E)[S, :]
     cols = []
     for j in range(E.shape[1]):
         xp, _ = P(x + h * E[:, j])
@@ -206,17 +230,23 @@ def find_fixed_point(
     atol: float = FIXED_POINT_TOL,
     tol: float = RESIDUAL_TOL,
     max_iter: int = 40,
+    jacobian: str = "exact",
 ) -> LimitCycle:
     """Fixed point of the ``period``-step return map, its step time and Floquet multipliers.
 
     Damped Newton in reduced section coordinates; ``tol`` bounds the residual
-    ``|P(x) − x|∞`` of the returned post-impact state.
+    ``|P(x) − x|∞`` of the returned post-impact state. ``jacobian``: ``"exact"`` (variational
+    equations and saltation matrices) or ``"fd"`` (central differences, step 1e-5: a cross-check
+    whose error scales with the step squared). A period-k search that lands on an orbit of lower
+    period d reports period d and ``requested_period`` k.
     """
+    if jacobian not in ("exact", "fd"):
+        raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
     P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
     x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
-        return _newton(system, P, x, period, tol, max_iter)
+        return _newton(system, P, x, period, tol, max_iter, jacobian)
     except (SimulationError, ConvergenceError) as e:
         if guess is not None or not params:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
@@ -231,7 +261,7 @@ def find_fixed_point(
         stage = {k: defaults[k] + s * (target[k] - defaults[k]) for k in target}
         try:
             lc = find_fixed_point(system, x, params=stage, period=period, rtol=rtol, atol=atol, tol=tol,
-                                  max_iter=max_iter)
+                                  max_iter=max_iter, jacobian=jacobian)
         except ConvergenceError as e:
             raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
                                    f"{i}/{stages} of the way ({e})") from None
@@ -239,7 +269,8 @@ def find_fixed_point(
     return lc
 
 
-def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int) -> LimitCycle:
+def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,
+            method: str = "exact", requested: int | None = None) -> LimitCycle:
     y, _ = P(x)  # start on the section
     it = 0
     res = math.inf
@@ -250,7 +281,7 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
         if res < tol:
             break
         S, E = _chart(P.section_basis(y))
-        A = _jacobian(P, y, E, S)
+        A = _jacobian(P, y, E, S, method)
         try:
             dxi = np.linalg.solve(A - np.eye(len(S)), -r[S])
         except np.linalg.LinAlgError:
@@ -275,18 +306,32 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
     _refuse_rest(system, P, xs, T)
     lower = _lower_period(P, xs, period, tol)
     if lower:
-        # the k-step orbit is a shorter one repeated: report that one
+        # the k-step orbit is a shorter one repeated: report that one, and that it was asked as k
         return _newton(system, ReturnMap(system, dict(zip(P.k.meta["params"], P.p.tolist())), period=lower,
-                                         rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter)
+                                         rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter,
+                       method, requested or period)
     S, E = _chart(P.section_basis(xs))
-    A = _jacobian(P, xs, E, S)
+    A = _jacobian(P, xs, E, S, method)
     mult = np.linalg.eigvals(A)
     mult = mult[np.argsort(-np.abs(mult))]
     names = P.k.meta["state_names"][P.mode]
+    orbit, times = _orbit(P, xs)
     return LimitCycle(system=system.name, mode=P.mode, state_names=list(names), fixed_point=xs, step_time=T / period,
                       multipliers=mult, section_coordinates=[names[i] for i in S],
                       residual=float(np.max(np.abs(Px - xs))), iterations=it, period=period,
-                      parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A, hybrid_system=system)
+                      parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A, hybrid_system=system,
+                      orbit=orbit, step_times=times, requested_period=requested)
+
+
+def _orbit(P: ReturnMap, x: np.ndarray) -> tuple[np.ndarray, list[float]]:
+    """The post-impact states after each step of one period (the fixed point first) and the
+    time of each step."""
+    r = run(P.k, P.p, P.mi, x, steps=P.period, opts=P.opts, record=True, events_only=True)
+    rec = r.recorded
+    step = [i for i, tr in enumerate(rec["etr"]) if P.k.meta["transitions"][int(tr)]["step"]]
+    times = np.diff(np.r_[0.0, rec["et"][step]]).tolist()
+    points = [x] + [rec["epost"][i][: P.k.meta["nx"][P.mi]] for i in step[:-1]]
+    return np.array(points), [float(v) for v in times]
 
 
 def _refuse_rest(system: HybridSystem, P: ReturnMap, x: np.ndarray, T: float) -> None:

@@ -86,6 +86,24 @@ class Options:
 
 
 @dataclass(slots=True)
+class Sensitivity:
+    """Derivatives of where a run ended with respect to its initial state ``x0`` and the
+    parameters ``p`` (in the kernels' parameter order), from the variational equations and the
+    saltation matrices of its events.
+
+    A run that ended at an event (its steps done, a terminal transition, the event cap) ended at
+    a time that moves with the data: ``dx_dx0``/``dx_dp`` are then the derivatives of the state at
+    that event (just after the reset for a step, just before a terminal one), and
+    ``dt_dx0``/``dt_dp`` those of the event time. A run that ended at a fixed time has ``dt = 0``.
+    """
+
+    dx_dx0: np.ndarray
+    dx_dp: np.ndarray
+    dt_dx0: np.ndarray
+    dt_dp: np.ndarray
+
+
+@dataclass(slots=True)
 class Run:
     """Where a run ended: ``code`` (an :data:`amble.backend.abi.STATUS` code), ``status`` (its
     outcome name; a terminal transition's own status, e.g. ``fell``), time ``t`` (s), ``mode``
@@ -103,6 +121,7 @@ class Run:
     info: int
     ctx: np.ndarray
     recorded: dict[str, Any]
+    sensitivity: Sensitivity | None = None
 
     @property
     def completed(self) -> bool:
@@ -131,11 +150,13 @@ def run(
     record: bool = False,
     events_only: bool = False,
     budget: int = RECORD_BUDGET,
+    sensitivities: bool = False,
 ) -> Run:
     """Run from ``x0`` in mode ``mode`` at ``t0`` until ``t_end`` (s), ``steps`` step transitions
     (0: no limit) or another end; record samples (every ``sample_dt`` s, 0: every integration step)
     and events when ``record`` (only events with ``events_only``). Recorded buffers never grow
-    past ``budget`` bytes: the run then ends as ``record_limit`` with what it recorded."""
+    past ``budget`` bytes: the run then ends as ``record_limit`` with what it recorded. With
+    ``sensitivities`` the run also carries ``∂x/∂(x0, p)`` (:class:`Sensitivity`)."""
     # Called once per return-map evaluation (tens of µs of compiled work): the arrays are laid
     # out from templates and index constants, not rebuilt field by field.
     nxm = k.nx_max
@@ -148,11 +169,13 @@ def run(
     iopt = opts._iopt.copy()
     iopt[_IO_MAXSTEPS] = steps
     buf = _Buffers(0 if events_only else 1024, 64, nxm) if record else _NO_RECORDING
+    sens = _sensitivity_buffer(k, x0.size) if sensitivities else None
+    sens_addr = sens.ctypes.data if sens is not None else None
     code = CODE["YIELD"]
     try:
         while True:
             iopt[_IO_OUTCAP], iopt[_IO_EVCAP] = buf.cap, buf.ecap
-            code = buf.call(k, p, ctx, opt, iopt)
+            code = buf.call(k, p, ctx, opt, iopt, sens_addr)
             if code == CODE["BUFFER_FULL"]:
                 if buf.nbytes_grown() > budget:  # the run is resumable here: stop with what it has
                     code = CODE["RECORD_LIMIT"]
@@ -164,7 +187,39 @@ def run(
         # Ctrl-C between two compiled calls: the run so far stays reachable as ``exc.run``
         exc.run = _result(k, CODE["YIELD"], ctx, buf)  # type: ignore[attr-defined]
         raise
-    return _result(k, code, ctx, buf)
+    r = _result(k, code, ctx, buf)
+    if sens is not None:
+        r.sensitivity = _sensitivity(k, r, sens, x0.size, p)
+    return r
+
+
+#: Runs that end at an event, whose end time therefore moves with the initial data.
+_AT_EVENT = (CODE["STEPS_DONE"], CODE["TERMINAL"], CODE["MAX_EVENTS"])
+
+
+def _sensitivity_buffer(k: Kernels, nx0: int) -> np.ndarray:
+    """``S = [I 0]`` (the initial state's own columns) and ``dτ = 0``, laid out as sensitivity.h reads it."""
+    sens = np.zeros((k.nx_max + 1) * k.sc)
+    S = sens[: k.nx_max * k.sc].reshape(k.nx_max, k.sc)
+    S[np.arange(nx0), np.arange(nx0)] = 1.0
+    return sens
+
+
+def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) -> Sensitivity:
+    nxm, sc, npar = k.nx_max, k.sc, len(k.meta["params"])
+    S = sens[: nxm * sc].reshape(nxm, sc)[: r.x.size]
+    tau = sens[nxm * sc :]
+    cols = np.r_[np.arange(nx0), nxm + np.arange(npar)]
+    S, tau = S[:, cols], tau[cols]
+    if r.code in _AT_EVENT:
+        # the buffer holds S at a fixed time just after the event: the state at the (moving)
+        # event itself adds its flow times dτ
+        f = k.rhs(r.mode, r.t, r.x, p)
+        S = S + np.outer(f, tau)
+    else:
+        tau = np.zeros_like(tau)
+    return Sensitivity(dx_dx0=S[:, :nx0].copy(), dx_dp=S[:, nx0:].copy(), dt_dx0=tau[:nx0].copy(),
+                       dt_dp=tau[nx0:].copy())
 
 
 def _result(k: Kernels, code: int, ctx: np.ndarray, buf: _Buffers) -> Run:
@@ -193,9 +248,9 @@ class _Buffers:
         return tuple(a.ctypes.data for a in (self.t, self.mode, self.x, self.n, self.et, self.etr, self.epre,
                                              self.epost, self.ne))
 
-    def call(self, k: Kernels, p, ctx, opt, iopt) -> int:
+    def call(self, k: Kernels, p, ctx, opt, iopt, sens: int | None = None) -> int:
         out = self._addresses if self is _NO_RECORDING else self.addresses()
-        return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *out))
+        return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *out, sens))
 
     def nbytes_grown(self) -> int:
         """Bytes the buffers would hold after :meth:`grow`."""
