@@ -145,6 +145,13 @@ class ReturnMap:
             raise SimulationError("return map: an event grazes its guard (ġ = 0), the map is not differentiable here")
         return r.x, r.t, s
 
+    def section_jacobian(self, x: np.ndarray, method: str = "exact") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The map's Jacobian ``A`` in the section chart at ``x`` (its eigenvalues at a fixed
+        point are the nontrivial multipliers), the chart's state coordinates ``S`` and ``E``,
+        the map from chart increments to state increments. ``method``: ``"exact"`` or ``"fd"``."""
+        S, E = _chart(self.section_basis(x))
+        return _jacobian(self, x, E, S, method), S, E
+
     def last_impact(self, x: np.ndarray) -> tuple[int, float, np.ndarray]:
         """(transition index, time, pre-event state) of the last footfall when mapping ``x``."""
         r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, record=True,
@@ -280,8 +287,7 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
         res = float(np.max(np.abs(r)))
         if res < tol:
             break
-        S, E = _chart(P.section_basis(y))
-        A = _jacobian(P, y, E, S, method)
+        A, S, E = P.section_jacobian(y, method)
         try:
             dxi = np.linalg.solve(A - np.eye(len(S)), -r[S])
         except np.linalg.LinAlgError:
@@ -310,8 +316,7 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
         return _newton(system, ReturnMap(system, dict(zip(P.k.meta["params"], P.p.tolist())), period=lower,
                                          rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter,
                        method, requested or period)
-    S, E = _chart(P.section_basis(xs))
-    A = _jacobian(P, xs, E, S, method)
+    A, S, E = P.section_jacobian(xs, method)
     mult = np.linalg.eigvals(A)
     mult = mult[np.argsort(-np.abs(mult))]
     names = P.k.meta["state_names"][P.mode]
