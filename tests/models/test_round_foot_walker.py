@@ -179,3 +179,69 @@ def test_zero_radius_from_the_default_guess_finds_the_compass_gait_too(rfw):
     lc = find_fixed_point(rfw, params=dict(r=0.0, I=0.0, l=1.0, c=0.5))
     # Goswami et al.'s compass gait at slope 0.05 (docs/references.md): stance −0.2168, swing 0.3168
     np.testing.assert_allclose(lc.fixed_point[:2], [-0.21682, 0.31682], atol=1e-5)
+
+
+def scipy_walker(v):
+    """The walker written again from scratch: Lagrange's equations by SymPy from the kinematics
+    above, SciPy's DOP853 with event location, and the impact solved from the two conservation
+    laws (angular momentum about the contact, trailing leg about the hip) — linear in the
+    post-impact velocities. Returns the stride map of the section (stance, stance_dot, swing_dot)
+    and the step time."""
+    import sympy as sp
+    from scipy.integrate import solve_ivp
+
+    q, qd = sp.symbols("q0 q1", real=True), sp.symbols("u0 u1", real=True)
+    gam, r, l, c = (v[k] for k in ("slope", "r", "l", "c"))
+    n, d = sp.Matrix([np.sin(gam), np.cos(gam)]), sp.Matrix([np.cos(gam), -np.sin(gam)])
+    e = lambda a: sp.Matrix([sp.sin(a), sp.cos(a)])  # noqa: E731
+    hip = r * (q[0] - gam) * d + r * n + l * e(q[0])
+    masses = [(v["mh"], hip), (v["m"], hip - c * e(q[0])), (v["m"], hip - c * e(q[1]))]
+    vel = lambda p: p.jacobian(q) * sp.Matrix(qd)  # noqa: E731
+    K = sum(mi * (vel(p).T * vel(p))[0] / 2 for mi, p in masses) + v["I"] * (qd[0] ** 2 + qd[1] ** 2) / 2
+    V = sum(mi * v["g"] * p[1] for mi, p in masses)
+    L = K - V
+    M = sp.Matrix(2, 2, lambda i, j: sp.diff(L, qd[i], qd[j]))
+    rest = sp.Matrix([sum(sp.diff(L, qd[i], q[j]) * qd[j] for j in range(2)) - sp.diff(L, q[i]) for i in range(2)])
+    acc = sp.lambdify([q, qd], M.LUsolve(-rest))
+
+    def height(t, x):
+        return float(np.array([np.sin(gam), np.cos(gam)]) @ kinematics(x, v)[0]["swing_contact"])
+
+    def ahead(t, x):  # the swing foot's contact 0.1 m ahead of the stance foot's
+        pos = kinematics(x, v)[0]
+        return float(np.array([np.cos(gam), -np.sin(gam)]) @ (pos["swing_contact"] - pos["stance_contact"])) - 0.1
+
+    height.terminal, height.direction, ahead.terminal, ahead.direction = True, -1, True, 1
+    rhs = lambda t, x: np.concatenate([x[2:], np.ravel(acc(x[:2], x[2:]))])  # noqa: E731
+    tol = dict(method="DOP853", rtol=1e-12, atol=1e-12)
+
+    def impact(x):
+        def linear(f):  # the matrix of a function linear in the velocities
+            return np.array([[f(np.array([*x[[1, 0]], *b])) for b in np.eye(2)]]).reshape(2)
+        rows = [linear(lambda y: momentum_about(y, v, "stance_contact")),
+                linear(lambda y: momentum_about(y, v, "hip", legs=("swing",)))]
+        rhs_ = [momentum_about(x, v, "swing_contact"), momentum_about(x, v, "hip", legs=("stance",))]
+        return np.array([*x[[1, 0]], *np.linalg.solve(np.array(rows), rhs_)])
+
+    def stride(y):
+        x = np.array([y[0], 2 * gam - y[0], y[1], y[2]])
+        a = solve_ivp(rhs, (0, 5), x, events=ahead, **tol)
+        b = solve_ivp(rhs, (a.t[-1], 5), a.y[:, -1], events=height, **tol)
+        post = impact(b.y_events[0][0])
+        return post[[0, 2, 3]], b.t_events[0][0]
+
+    return stride
+
+
+@pytest.mark.parametrize("params", [None, pytest.param(OTHER, marks=pytest.mark.slow)])
+def test_fixed_point_and_multipliers_agree_with_an_independent_scipy_model(rfw, params):
+    lc = find_fixed_point(rfw, params=params)
+    stride = scipy_walker(values(build(rfw), params))
+    y = lc.fixed_point[[0, 2, 3]]
+    image, step_time = stride(y)
+    np.testing.assert_allclose(image, y, rtol=0, atol=1e-9)  # amble's fixed point is one of SciPy's map
+    assert step_time == pytest.approx(lc.step_time, abs=1e-9)
+    h = 1e-5  # central differences of SciPy's map: the multipliers
+    jac = np.array([(stride(y + h * b)[0] - stride(y - h * b)[0]) / (2 * h) for b in np.eye(3)]).T
+    key = lambda z: (abs(z), z.imag)  # noqa: E731
+    np.testing.assert_allclose(sorted(np.linalg.eigvals(jac), key=key), sorted(lc.multipliers, key=key), atol=1e-6)
