@@ -211,27 +211,46 @@ def find_fixed_point(
 
     Damped Newton in reduced section coordinates; ``tol`` bounds the residual
     ``|P(x) − x|∞`` of the returned post-impact state.
+
+    Without a ``guess`` the search starts from :func:`default_guess`. At parameters other than
+    the defaults, when that search fails or finds an unstable cycle, the model's own gait (its
+    guess, on the cycle at the default parameters) is also followed to the requested parameters
+    by continuation, and the cycle found that way is returned if it is stable: a walker whose
+    default gait is stable finds the stable branch connected to it, not whichever cycle lies
+    nearest a poor guess.
     """
     P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
     x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
-        return _newton(system, P, x, period, tol, max_iter)
+        direct = _newton(system, P, x, period, tol, max_iter)
     except (SimulationError, ConvergenceError) as e:
         if guess is not None or not params:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
-    # The model's own guess lies on the cycle at its default parameters: follow the cycle from
-    # there to the requested parameters in a few continuation stages.
+        direct = None
+    at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
+    if direct is not None and (direct.stable or guess is not None or at_defaults):
+        return direct
+    try:
+        followed = _from_defaults(system, P, x0, period=period, rtol=rtol, atol=atol, tol=tol, max_iter=max_iter)
+    except ConvergenceError:
+        if direct is not None:
+            return direct
+        raise
+    return followed if direct is None or followed.stable else direct
+
+
+def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, stages: int = 8, **kw: Any) -> LimitCycle:
+    """The model's own guess lies on the cycle at its default parameters: follow the cycle from
+    there to the parameters of ``P`` in ``stages`` continuation stages."""
     defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
     target = dict(zip(P.k.meta["params"], P.p.tolist()))
     x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
-    stages = 8
     for i in range(1, stages + 1):
         s = i / stages
         stage = {k: defaults[k] + s * (target[k] - defaults[k]) for k in target}
         try:
-            lc = find_fixed_point(system, x, params=stage, period=period, rtol=rtol, atol=atol, tol=tol,
-                                  max_iter=max_iter)
+            lc = find_fixed_point(system, x, params=stage, **kw)
         except ConvergenceError as e:
             raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
                                    f"{i}/{stages} of the way ({e})") from None
