@@ -45,7 +45,7 @@ rad/s; step 0.74061 s; multipliers 0.1554 ± 0.4837i and 0.1353.
 from amble import NONNEGATIVE, POSITIVE, Model, R, rolling_centre, round_foot, walker
 
 NAME = "round-foot-walker"
-POSITION = 15  # place in `amble models` (ascending)
+POSITION = 65  # place in `amble models` (ascending)
 
 
 def build():
