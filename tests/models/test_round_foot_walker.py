@@ -245,3 +245,47 @@ def test_fixed_point_and_multipliers_agree_with_an_independent_scipy_model(rfw, 
     jac = np.array([(stride(y + h * b)[0] - stride(y - h * b)[0]) / (2 * h) for b in np.eye(3)]).T
     key = lambda z: (abs(z), z.imag)  # noqa: E731
     np.testing.assert_allclose(sorted(np.linalg.eigvals(jac), key=key), sorted(lc.multipliers, key=key), atol=1e-6)
+
+
+def test_the_rolling_point_moves_with_the_material_point_at_the_contact():
+    # v = ċ + ω × (−r n), the cross product taken in 3D (x, y, z): the plane's angles turn about +y
+    # (R(θ) is the vertical (0, 0, 1) turned by θ about +y, leaning toward +x)
+    import sympy as sp
+
+    m = Model("disc")
+    (th,) = m.coordinates("theta")
+    r, gam, x0 = m.parameters(r=0.3, slope=0.1, x0=0.2)
+    foot = round_foot(m, "foot", sp.Matrix([x0, 1]) + 0.5 * R(th), th, r, gam)
+    centre = m.points[foot.centre]
+    vc = m.jacobian(centre) * sp.Matrix([m.dot(th)])
+    omega = sp.Matrix([0, m.dot(th), 0])
+    arm = -r * sp.Matrix([sp.sin(gam), 0, sp.cos(gam)])
+    v3 = sp.Matrix([vc[0], 0, vc[1]]) + omega.cross(arm)
+    v = m.jacobian(m.points[foot.rolling]) * sp.Matrix([m.dot(th)])
+    assert sp.simplify(v - sp.Matrix([v3[0], v3[2]])) == sp.zeros(2, 1)
+    # while the lowest point of the arc moves with the centre only
+    lowest = m.jacobian(m.points[foot.contact]) * sp.Matrix([m.dot(th)])
+    assert sp.simplify(lowest - vc) == sp.zeros(2, 1)
+
+
+def test_a_rolling_stance_foot_advances_r_dtheta_and_its_material_point_is_at_rest():
+    import sympy as sp
+
+    m = Model("wheel")
+    (th,) = m.coordinates("theta")
+    r, gam = m.parameters(r=0.3, slope=0.1)
+    foot = round_foot(m, "foot", rolling_centre(th, r, gam), th, r, gam)
+    contact = m.points[foot.contact]
+    downhill = sp.Matrix([sp.cos(gam), -sp.sin(gam)])
+    assert sp.simplify((downhill.T * sp.diff(contact, th))[0] - r) == 0  # d(contact)/dθ = r along the slope
+    assert sp.simplify(sp.Matrix([sp.sin(gam), sp.cos(gam)]).T * contact)[0] == 0  # on the slope
+    assert sp.simplify(m.points[foot.rolling]) == sp.zeros(2, 1)
+
+
+def test_round_feet_are_planar():
+    from amble import ModelError
+
+    m = Model("spatial", dims=3)
+    (th,) = m.coordinates("theta")
+    with pytest.raises(ModelError, match="planar"):
+        round_foot(m, "foot", (0, 0, 1), th, 0.1, 0.0)
