@@ -289,3 +289,14 @@ def test_round_feet_are_planar():
     (th,) = m.coordinates("theta")
     with pytest.raises(ModelError, match="planar"):
         round_foot(m, "foot", (0, 0, 1), th, 0.1, 0.0)
+
+
+def test_the_default_search_finds_the_gait_in_other_units_and_time_scales_as_sqrt_l_over_g(rfw):
+    # a light walker in units where g = 1 (most of the mass at the hip, as McGeer's): gravity only
+    # sets the time scale, so the angles stay, rates scale with √g and the step time with 1/√g
+    light = dict(mh=0.68, m=0.16, I=0.16 * 0.35**2, l=0.7, c=0.35, r=0.3, slope=0.025)
+    unit = find_fixed_point(rfw, params=dict(light, g=1.0))
+    si = find_fixed_point(rfw, unit.fixed_point * [1, 1, 9.81**0.5, 9.81**0.5], params=dict(light, g=9.81))
+    assert unit.stable and si.stable
+    np.testing.assert_allclose(si.fixed_point, unit.fixed_point * [1, 1, 9.81**0.5, 9.81**0.5], atol=1e-9)
+    assert si.step_time * 9.81**0.5 == pytest.approx(unit.step_time, abs=1e-9)

@@ -231,30 +231,50 @@ def find_fixed_point(
     at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
     if direct is not None and (direct.stable or guess is not None or at_defaults):
         return direct
-    try:
-        followed = _from_defaults(system, P, x0, period=period, rtol=rtol, atol=atol, tol=tol, max_iter=max_iter)
-    except ConvergenceError:
-        if direct is not None:
-            return direct
-        raise
-    return followed if direct is None or followed.stable else direct
+    found = [direct] if direct is not None else []
+    error = None
+    for geometric in (False, True):
+        try:
+            followed = _from_defaults(system, P, x0, geometric, period=period, rtol=rtol, atol=atol, tol=tol,
+                                      max_iter=max_iter)
+        except ConvergenceError as e:
+            error = error or e
+            continue
+        if followed.stable:
+            return followed
+        found.append(followed)
+    if found:
+        return found[0]
+    raise error
 
 
-def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, stages: int = 8, **kw: Any) -> LimitCycle:
+def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, geometric: bool, stages: int = 16,
+                   **kw: Any) -> LimitCycle:
     """The model's own guess lies on the cycle at its default parameters: follow the cycle from
-    there to the parameters of ``P`` in ``stages`` continuation stages."""
+    there to the parameters of ``P``, in ``stages`` equal stages while each converges; a stage
+    that fails is halved (down to 1/32 of a stage), since cycles can move fast near the target.
+    The parameters move linearly, or, with ``geometric``, those positive at both ends
+    geometrically (masses, lengths and gravity keep their ratios changing evenly)."""
     defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
     target = dict(zip(P.k.meta["params"], P.p.tolist()))
+
+    def at(s: float) -> dict[str, float]:
+        return {k: defaults[k] * (target[k] / defaults[k]) ** s if geometric and defaults[k] > 0 and target[k] > 0
+                else defaults[k] + s * (target[k] - defaults[k]) for k in target}
+
     x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
-    for i in range(1, stages + 1):
-        s = i / stages
-        stage = {k: defaults[k] + s * (target[k] - defaults[k]) for k in target}
+    done, step, lc = 0.0, 1.0 / stages, None
+    while done < 1.0:
+        s = min(1.0, done + step)
         try:
-            lc = find_fixed_point(system, x, params=stage, **kw)
+            lc = find_fixed_point(system, x, params=target if s == 1.0 else at(s), **kw)
         except ConvergenceError as e:
-            raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
-                                   f"{i}/{stages} of the way ({e})") from None
-        x = lc.fixed_point
+            if step < 1.0 / (32 * stages):
+                raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
+                                       f"{done:.0%} of the way ({e})") from None
+            step /= 2
+            continue
+        x, done = lc.fixed_point, s
     return lc
 
 

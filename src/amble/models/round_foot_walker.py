@@ -53,8 +53,8 @@ def build():
     st, sw = m.coordinates("stance swing")
     mh, ml, I, l, c, r, g, slope = m.parameters(mh=10.0, m=5.0, I=0.2042, l=0.7, c=0.35, r=0.3, g=9.81,
                                                 slope=0.05)
-    m.restrict("mh m l g", POSITIVE)
-    m.restrict("I c r", NONNEGATIVE)
+    m.restrict("m l g", POSITIVE)
+    m.restrict("mh I c r", NONNEGATIVE)
     stance = round_foot(m, "stance_foot", rolling_centre(st, r, slope), st, r, slope)
     hip = m.point("hip", m.points[stance.centre] + l * R(st), mass=mh, link=stance.centre)
     m.point("stance_mass", hip - c * R(st), mass=ml)
