@@ -251,10 +251,11 @@ def find_fixed_point(
 def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, geometric: bool, stages: int = 16,
                    **kw: Any) -> LimitCycle:
     """The model's own guess lies on the cycle at its default parameters: follow the cycle from
-    there to the parameters of ``P``, in ``stages`` equal stages while each converges; a stage
-    that fails is halved (down to 1/32 of a stage), since cycles can move fast near the target.
-    The parameters move linearly, or, with ``geometric``, those positive at both ends
-    geometrically (masses, lengths and gravity keep their ratios changing evenly)."""
+    there to the parameters of ``P`` in stages of ``1/stages`` of the way; a stage that fails is
+    halved (down to 1/32 of one), the next after a success doubled back, since cycles can move
+    fast near the target; at most ``3 × stages`` searches in all. The parameters move linearly,
+    or, with ``geometric``, those positive at both ends geometrically (masses, lengths and
+    gravity keep their ratios changing evenly)."""
     defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
     target = dict(zip(P.k.meta["params"], P.p.tolist()))
 
@@ -264,18 +265,21 @@ def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, geometric
 
     x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
     done, step, lc = 0.0, 1.0 / stages, None
-    while done < 1.0:
+    for searches in range(1, 3 * stages + 1):
         s = min(1.0, done + step)
         try:
             lc = find_fixed_point(system, x, params=target if s == 1.0 else at(s), **kw)
         except ConvergenceError as e:
-            if step < 1.0 / (32 * stages):
+            if step < 1.0 / (32 * stages) or searches == 3 * stages:
                 raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
                                        f"{done:.0%} of the way ({e})") from None
             step /= 2
             continue
-        x, done = lc.fixed_point, s
-    return lc
+        x, done, step = lc.fixed_point, s, min(2 * step, 1.0 / stages)
+        if done == 1.0:
+            return lc
+    raise ConvergenceError(f"no fixed point: continuation from the default parameters reached only {done:.0%} "
+                           f"of the way in {3 * stages} searches")
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int) -> LimitCycle:
