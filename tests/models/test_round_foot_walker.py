@@ -63,6 +63,12 @@ def kinetic(x, v):
                   + vel["swing_mass"] @ vel["swing_mass"]) + v["I"] * (x[2] ** 2 + x[3] ** 2))
 
 
+def momentum(x, v):
+    """Linear momentum (kg·m/s)."""
+    vel = kinematics(x, v)[1]
+    return v["mh"] * vel["hip"] + v["m"] * (vel["stance_mass"] + vel["swing_mass"])
+
+
 def energy(x, v):
     """Kinetic plus potential energy (J), heights from the origin of the state's step frame."""
     pos = kinematics(x, v)[0]
@@ -139,6 +145,14 @@ def test_energy_is_conserved_over_the_swing_and_lost_at_heel_strike(rfw, params)
     d = np.array([np.cos(v["slope"]), -np.sin(v["slope"])])
     assert abs(np.array([np.sin(v["slope"]), np.cos(v["slope"])]) @ pos["swing_contact"]) < 1e-10
     assert d @ (pos["swing_contact"] - pos["stance_contact"]) > 0.1
+    # a valid footfall: the ground pushes (the impulse, the change of linear momentum, points out
+    # of the slope) and the trailing foot's material point leaves the ground
+    n = np.array([np.sin(v["slope"]), np.cos(v["slope"])])
+    assert n @ (momentum(ev.x_post, v) - momentum(ev.x_pre, v)) > 0
+    sw, dsw = ev.x_post[1], ev.x_post[3]
+    hip = kinematics(ev.x_post, v)[1]["hip"]
+    trailing = hip - v["l"] * dsw * np.array([np.cos(sw), -np.sin(sw)]) - v["r"] * dsw * d  # ċ + ω × (−r n)
+    assert n @ trailing > 0
 
 
 def test_world_positions_are_continuous_through_the_footfall(rfw):
