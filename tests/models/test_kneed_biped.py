@@ -179,7 +179,7 @@ def test_hsu_chen_euler_fixed_point_converges_to_the_accurate_one_at_first_order
 HSU_CHEN_SLOPES = [float(np.arcsin(7.25 / 144)), 0.0504, 0.06]
 
 
-@pytest.mark.parametrize("slope", HSU_CHEN_SLOPES)
+@pytest.mark.parametrize("slope", [*HSU_CHEN_SLOPES, 0.04, 0.07])
 def test_default_search_finds_the_stable_gait_at_hsu_chens_parameters(kneed, slope):
     params = dict(HSU_CHEN, slope=slope)
     lc = find_fixed_point(kneed, params=params)
