@@ -19,7 +19,9 @@ Heel strike when the swing foot's arc reaches the slope ahead of the stance foot
 equal legs: ``stance + swing = 2·slope``, as with point feet). The impact is plastic, without
 slip, on the material point of the swing foot at the contact (derived; the old stance foot
 lifts off): it conserves the whole walker's angular momentum about that point and the trailing
-leg's about the hip. Then the legs swap.
+leg's about the hip. Then the legs swap. Points: ``hip``, ``stance_mass``, ``swing_mass``, and for
+each foot its contact (``stance_foot``, ``swing_foot``), ``…_centre`` and ``…_rolling`` (see
+:func:`amble.round_foot`).
 
 Parameters (defaults: a leg of total length l + r = 1 m, its mass a 5 kg uniform rod between
 the hip and the foot's arc centre, a hip mass of 10 kg as in the compass gait):
@@ -27,7 +29,7 @@ the hip and the foot's arc centre, a hip mass of 10 kg as in the compass gait):
 =========  =======  ======  ====================================================
 name       default  unit    meaning
 =========  =======  ======  ====================================================
-``mh``     10       kg      hip point mass
+``mh``     10       kg      hip point mass (may be 0)
 ``m``      5        kg      mass of each leg
 ``I``      0.2042   kg·m²   each leg's moment of inertia about its centre of mass (≈ m l²/12)
 ``l``      0.7      m       hip to the centre of the foot's arc
