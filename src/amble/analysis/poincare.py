@@ -246,6 +246,13 @@ def find_fixed_point(
     equations and saltation matrices) or ``"fd"`` (central differences, step 1e-5: a cross-check
     whose error scales with the step squared). A period-k search that lands on an orbit of lower
     period d reports period d and ``requested_period`` k.
+
+    Without a ``guess`` the search starts from :func:`default_guess`. At parameters other than
+    the defaults, when that search fails or finds an unstable cycle, the model's own gait (its
+    guess, on the cycle at the default parameters) is also followed to the requested parameters
+    by continuation, and the cycle found that way is returned if it is stable: a walker whose
+    default gait is stable finds the stable branch connected to it, not whichever cycle lies
+    nearest a poor guess.
     """
     if jacobian not in ("exact", "fd"):
         raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
@@ -253,27 +260,63 @@ def find_fixed_point(
     x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
-        return _newton(system, P, x, period, tol, max_iter, jacobian)
+        direct = _newton(system, P, x, period, tol, max_iter, jacobian)
     except (SimulationError, ConvergenceError) as e:
         if guess is not None or not params:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
-    # The model's own guess lies on the cycle at its default parameters: follow the cycle from
-    # there to the requested parameters in a few continuation stages.
+        direct = None
+    at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
+    if direct is not None and (direct.stable or guess is not None or at_defaults):
+        return direct
+    found = [direct] if direct is not None else []
+    error = None
+    for geometric in (False, True):
+        try:
+            followed = _from_defaults(system, P, x0, geometric, period=period, rtol=rtol, atol=atol, tol=tol,
+                                      max_iter=max_iter, jacobian=jacobian)
+        except ConvergenceError as e:
+            error = error or e
+            continue
+        if followed.stable:
+            return followed
+        found.append(followed)
+    if found:
+        return found[0]
+    raise error
+
+
+def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, geometric: bool, stages: int = 16,
+                   **kw: Any) -> LimitCycle:
+    """The model's own guess lies on the cycle at its default parameters: follow the cycle from
+    there to the parameters of ``P`` in stages of ``1/stages`` of the way; a stage that fails is
+    halved (down to 1/32 of one), the next after a success doubled back, since cycles can move
+    fast near the target; at most ``3 × stages`` searches in all. The parameters move linearly,
+    or, with ``geometric``, those positive at both ends geometrically (masses, lengths and
+    gravity keep their ratios changing evenly)."""
     defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
     target = dict(zip(P.k.meta["params"], P.p.tolist()))
+
+    def at(s: float) -> dict[str, float]:
+        return {k: defaults[k] * (target[k] / defaults[k]) ** s if geometric and defaults[k] > 0 and target[k] > 0
+                else defaults[k] + s * (target[k] - defaults[k]) for k in target}
+
     x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
-    stages = 8
-    for i in range(1, stages + 1):
-        s = i / stages
-        stage = {k: defaults[k] + s * (target[k] - defaults[k]) for k in target}
+    done, step, lc = 0.0, 1.0 / stages, None
+    for searches in range(1, 3 * stages + 1):
+        s = min(1.0, done + step)
         try:
-            lc = find_fixed_point(system, x, params=stage, period=period, rtol=rtol, atol=atol, tol=tol,
-                                  max_iter=max_iter, jacobian=jacobian)
+            lc = find_fixed_point(system, x, params=target if s == 1.0 else at(s), **kw)
         except ConvergenceError as e:
-            raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
-                                   f"{i}/{stages} of the way ({e})") from None
-        x = lc.fixed_point
-    return lc
+            if step < 1.0 / (32 * stages) or searches == 3 * stages:
+                raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
+                                       f"{done:.0%} of the way ({e})") from None
+            step /= 2
+            continue
+        x, done, step = lc.fixed_point, s, min(2 * step, 1.0 / stages)
+        if done == 1.0:
+            return lc
+    raise ConvergenceError(f"no fixed point: continuation from the default parameters reached only {done:.0%} "
+                           f"of the way in {3 * stages} searches")
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,
