@@ -143,9 +143,17 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
             animate(tr, anim_p)
             out["animation"] = str(anim_p)
     if not args.json:
+        unit = s.time_unit
+        if lc.requested_period and lc.requested_period != lc.period:
+            print(f"{args.model}: the period-{lc.requested_period} search converged to a period-{lc.period} gait")
         print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
-              f"step time {lc.step_time:.6g} s (residual {lc.residual:.1e}, {lc.iterations} iterations)")
-        print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
+              f"{'mean ' if lc.period > 1 else ''}step time {lc.step_time:.6g} {unit} (residual {lc.residual:.1e}, {lc.iterations} iterations)")
+        if lc.period == 1:
+            print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
+        else:  # every point of the orbit and the time of every step: the mean alone hides the alternation
+            for i, (point, dt) in enumerate(zip(lc.orbit, lc.step_times), 1):
+                print(f"point {i}/{lc.period} (step time {dt:.6g} {unit}): "
+                      + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, point)))
         print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
         for k in ("plot", "animation"):
             if k in out:
@@ -211,7 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)
-    lc.add_argument("--period", type=int, default=1, help="k for a period-k gait (default 1)")
+    lc.add_argument("--period", type=int, default=1, help="k for a period-k gait (default 1); all k points and step times are reported")
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
