@@ -131,10 +131,11 @@ class ReturnMap:
             raise SimulationError("return map: the walker did not come back to the section's mode")
         return r.x, r.t
 
-    def derivatives(self, x: np.ndarray) -> tuple[np.ndarray, float, Sensitivity]:
+    def derivatives(self, x: np.ndarray, params: bool = True) -> tuple[np.ndarray, float, Sensitivity]:
         """``P(x)``, the elapsed time and the exact derivatives of both with respect to ``x`` and
-        the parameters (one compiled run with the variational equations)."""
-        r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, sensitivities=True)
+        (with ``params``) the parameters: one compiled run with the variational equations."""
+        r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts,
+                sensitivities=True if params else "state")
         if not r.completed:
             raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
         if r.mode != self.mi:
@@ -203,7 +204,7 @@ def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, method:
     """The return map's Jacobian in chart coordinates: increments ``E ξ`` of the state, the
     chart coordinates ``S`` of the image."""
     if method == "exact":
-        return (P.derivatives(x)[2].dx_dx0 @ E)[S, :]
+        return (P.derivatives(x, params=False)[2].dx_dx0 @ E)[S, :]
     cols = []
     for j in range(E.shape[1]):
         xp, _ = P(x + h * E[:, j])

@@ -201,6 +201,8 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
              "void", "kinematics_{}(t, x, p, pos, vel)", mode_list, "mode")
     dispatch("rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J)", "int",
              "rhs_jac_{}(t, x, p, dx, J)", mode_list, "mode")
+    dispatch("rhs_jacp(int mode, double t, const double *x, const double *p, double *J)", "int",
+             "rhs_jacp_{}(t, x, p, J)", mode_list, "mode")
     dispatch("surfaces_grad(int mode, double t, const double *x, const double *p, double *G)", "void",
              "surfaces_grad_{}(t, x, p, G)", mode_list, "mode")
     dispatch("reset_jac(int tr, double t, const double *x, const double *p, double *D)", "int",

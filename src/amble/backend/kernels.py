@@ -93,6 +93,8 @@ class Kernels:
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
         lib.amble_rhs_jac.restype = ctypes.c_int
         lib.amble_rhs_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr]
+        lib.amble_rhs_jacp.restype = ctypes.c_int
+        lib.amble_rhs_jacp.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         lib.amble_surfaces_grad.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         lib.amble_reset_jac.restype = ctypes.c_int
         lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
@@ -158,6 +160,7 @@ class Kernels:
         x = _vec(x, nx)
         dx, J = np.zeros(nx), np.zeros((nx, self.sc))
         err = self._lib.amble_rhs_jac(mi, float(t), _p(x), _p(p), _p(dx), _p(J))
+        err = err or self._lib.amble_rhs_jacp(mi, float(t), _p(x), _p(p), _p(J))
         if err:
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         npar = len(self.meta["params"])

@@ -52,14 +52,20 @@ def _defs(mi: ModeInfo) -> tuple[list, sp.Matrix, sp.Matrix]:
     return eq.compact if eq.compact is not None else ([], eq.M, eq.h)
 
 
-def rhs_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[str]) -> str:
-    """``rhs_jac_k``: ``dx = f`` and ``J = ∂f/∂(x, p)`` (rows of ``SC``)."""
+def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[str], of_params: bool) -> str:
+    """The flow Jacobian's acceleration rows with respect to the state (``rhs_jac_k``: also the
+    right-hand side, and the position rows) or to the parameters (``rhs_jacp_k``). Two kernels,
+    because a fixed-point search needs only the first and parameters touch most of the program."""
     m, eq, k = mi.model, mi.equations, mi.index
     n = len(m.q)
     defs, M, h = _defs(mi)
-    psyms = _param_symbols(m, params)
-    inputs = [*m.q, *m.qd, *[s if s is not None else sp.Dummy() for s in psyms]]
-    nv = len(inputs)
+    if of_params:
+        inputs = [s if s is not None else sp.Dummy() for s in _param_symbols(m, params)]
+        col = "NXMAX + v"
+    else:
+        inputs = [*m.q, *m.qd]
+        col = "v"
+    nv = max(len(inputs), 1)
     low = [(i, j) for i in range(n) for j in range(i + 1)]
     exprs = [M[i, j] for i, j in low] + [eq.Gamma[i] - h[i] for i in range(n)]
     vt = [f"M[{i * n + j}]" for i, j in low] + [f"f[{i}]" for i in range(n)]
@@ -68,25 +74,35 @@ def rhs_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[st
     def target(o: int, v: int) -> str:
         return f"dM[{rows[o] * nv + v}]" if rows[o] is not None else f"dF[{(o - len(low)) * nv + v}]"
 
-    code = f"static int rhs_jac_{k}(double t, const double *x, const double *p, double *dx, double *J) {{\n"
+    if of_params:
+        code = f"static int rhs_jacp_{k}(double t, const double *x, const double *p, double *J) {{\n"
+    else:
+        code = f"static int rhs_jac_{k}(double t, const double *x, const double *p, double *dx, double *J) {{\n"
     code += f"    double M[{n * n}], f[{n}], dM[{n * n * nv}], dF[{n * nv}];\n    (void)t; (void)p;\n"
     code += "    memset(dM, 0, sizeof dM);\n    memset(dF, 0, sizeof dF);\n"
     code += jacobian_block(exprs, vt, target, inputs, names, defs=defs)
     code += f"    if (amble_chol_factor({n}, M)) return AMBLE_ERR_SINGULAR_MASS;\n"
     code += f"    amble_chol_apply({n}, M, f, 1);\n"
     # ∂q̈ = M⁻¹ (∂F − ∂M q̈), ∂M symmetric (its lower triangle was differentiated)
-    code += f"    for (int i = 0; i < {n}; ++i)\n        for (int v = 0; v < {nv}; ++v) {{\n"
+    code += f"    for (int i = 0; i < {n}; ++i)\n        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
     code += f"            double r = dF[i * {nv} + v];\n"
     code += f"            for (int l = 0; l < {n}; ++l) r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n"
     code += f"            dF[i * {nv} + v] = r;\n        }}\n"
     code += f"    amble_chol_apply({n}, M, dF, {nv});\n"
-    code += f"    for (int i = 0; i < {2 * n} * SC; ++i) J[i] = 0.0;\n"
-    code += f"    for (int i = 0; i < {n}; ++i) {{\n        dx[i] = x[{n} + i];\n        dx[{n} + i] = f[i];\n"
-    code += f"        J[i * SC + {n} + i] = 1.0;\n"
-    code += f"        for (int v = 0; v < {2 * n}; ++v) J[({n} + i) * SC + v] = dF[i * {nv} + v];\n"
-    code += f"        for (int j = 0; j < {len(params)}; ++j) J[({n} + i) * SC + NXMAX + j] = dF[i * {nv} + {2 * n} + j];\n"
+    code += f"    for (int i = 0; i < {n}; ++i) {{\n"
+    if of_params:
+        code += f"        for (int v = 0; v < {len(inputs)}; ++v) {{ J[i * SC + {col}] = 0.0; J[({n} + i) * SC + {col}] = dF[i * {nv} + v]; }}\n"
+    else:
+        code += f"        dx[i] = x[{n} + i];\n        dx[{n} + i] = f[i];\n"
+        code += f"        for (int v = 0; v < {2 * n}; ++v) {{ J[i * SC + v] = v == {n} + i; J[({n} + i) * SC + v] = dF[i * {nv} + v]; }}\n"
     code += "    }\n    return 0;\n}\n"
     return code
+
+
+def rhs_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[str]) -> str:
+    """``rhs_jac_k(t, x, p, dx, J)``: ``dx = f`` and the state columns of ``J = ∂f/∂x``;
+    ``rhs_jacp_k(t, x, p, J)``: its parameter columns ``∂f/∂p`` (rows of ``SC``)."""
+    return _flow_jacobian_code(mi, names, params, False) + _flow_jacobian_code(mi, names, params, True)
 
 
 def surfaces_gradient_code(mi: ModeInfo, surfaces: list[sp.Expr], names: dict[sp.Symbol, str],

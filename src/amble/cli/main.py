@@ -14,7 +14,7 @@ from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError
-from ..simulation.engine import Options
+from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .equations import cmd_equations
 
@@ -85,7 +85,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
     # samples are recorded only for an output that shows them: a summary needs the events alone
     tr = simulate(s, x0, params=params, steps=steps, t_end=args.time, rtol=args.rtol, atol=args.atol,
-                  sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p))
+                  sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
     if out_p:
         tr.save(out_p)
@@ -216,6 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
+    s.add_argument("--method", choices=METHODS, default="dop853",
+                   help="integrator: dop853 (explicit, default) or radau (implicit, for stiff models)")
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)

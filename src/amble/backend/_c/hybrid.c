@@ -1,6 +1,7 @@
 /* Hybrid simulation loop: integrate a mode, find the step's event, record, reset or end — all
  * in compiled code, one call per simulation. The pieces live in their own headers:
  *   dop853.h  the integrator (steps, dense output, Hermite interpolant)
+ *   radau.h   the implicit integrator for stiff runs (IO_METHOD = 1), same dense-output contract
  *   events.h  guard screening and crossing location inside a step
  *   record.h  sample and event rows in caller-owned buffers
  *
@@ -25,6 +26,7 @@
 
 #include "dop853.h"
 #include "events.h"
+#include "radau.h"
 #include "record.h"
 #include "sensitivity.h"
 
@@ -50,6 +52,10 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     if (nsub > NSUB_MAX) nsub = NSUB_MAX;
 
     Dop s;
+    s.radau = 0;
+    const int implicit = iopt[IO_METHOD] == 1;
+    Radau rad;
+    radau_reset(&rad);
     int mode = (int)ctx[CX_MODE];
     if (mode < 0 || mode >= NMODES) return ST_RESET_FAILED;
     s.n = MODE_NX[mode];
@@ -87,7 +93,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (max_step_time > 0.0 && ctx[CX_TLAST_STEP] + max_step_time < t_bound) t_bound = ctx[CX_TLAST_STEP] + max_step_time;
         s.t_old = t;
         double h_try = h_abs;
-        int st = dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try);
+        int st = implicit ? radau_step(&s, &rad, mode, p, t_bound, rtol, atol, max_step, &h_try)
+                          : dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try);
         if (st) { status = st; break; }
         const double t_new = t + s.h;
         const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode], nsf = n_surf(mode);
@@ -124,7 +131,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (ev_k < 0) {
             if (sens) {
                 double y1[NXMAX];
-                if ((st = sens_advance(mode, p, t, s.h, s.y_old, sens, y1))) { status = st; break; }
+                if ((st = sens_advance(mode, p, sens_cols(sens), t, s.h, s.y_old, sens, y1))) { status = st; break; }
             }
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }
@@ -138,6 +145,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             }
             continue;
         }
+        radau_reset(&rad); /* the flow jumps here: the Newton matrix and the predictor are stale */
         if (ev_k >= ntr) {
             /* --- a switching surface: restart the integrator on its far side, or stop if the flow
              * there points back into it (sliding) --- */
@@ -248,6 +256,10 @@ int amble_reset(int tr, double t, const double *x, const double *p, double *xout
 
 int amble_rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J) {
     return rhs_jac(mode, t, x, p, dx, J);
+}
+
+int amble_rhs_jacp(int mode, double t, const double *x, const double *p, double *J) {
+    return rhs_jacp(mode, t, x, p, J);
 }
 
 void amble_surfaces_grad(int mode, double t, const double *x, const double *p, double *G) {

@@ -21,24 +21,41 @@
 #define AMBLE_SENSITIVITY_H
 
 #define SENS_TAU (NXMAX * SC)
+#define SENS_NCS (SENS_TAU + SC) /* buffer entry: state columns carried (the initial state's size) */
+#define SENS_NCP (SENS_NCS + 1)  /* buffer entry: parameter columns carried (0 or NPARAM) */
 
-/* KS = J_x S + J_p for J = ∂f/∂(x, p) (rows of SC: state columns, then parameters). J_x is
- * sparse (its position rows are unit rows), so zero entries are skipped. */
-static void jac_times(int n, const double *J, const double *S, double *KS) {
+/* The columns a run carries: 0 … ncs−1 (initial state), NXMAX … NXMAX+ncp−1 (parameters). */
+typedef struct { int ncs, ncp; } Cols;
+
+static Cols sens_cols(const double *sens) { Cols c = {(int)sens[SENS_NCS], (int)sens[SENS_NCP]}; return c; }
+
+#define FOR_COLS(cl, c, body) \
+    do { for (int c = 0; c < (cl).ncs; ++c) { body } for (int c = NXMAX; c < NXMAX + (cl).ncp; ++c) { body } } while (0)
+
+/* J = ∂f/∂(x, p) at a state: state columns always, parameter columns if carried. */
+static int sens_jac(int mode, double t, const double *x, const double *p, Cols cl, double *dx, double *J) {
+    if (rhs_jac(mode, t, x, p, dx, J)) return ST_SINGULAR_MASS;
+    if (cl.ncp > 0 && rhs_jacp(mode, t, x, p, J)) return ST_SINGULAR_MASS;
+    return 0;
+}
+
+/* KS = J_x S + J_p over the carried columns (J_x is sparse: its position rows are unit rows). */
+static void jac_times(int n, Cols cl, const double *J, const double *S, double *KS) {
     for (int i = 0; i < n; ++i) {
         double *out = KS + i * SC;
-        for (int c = 0; c < SC; ++c) out[c] = c >= NXMAX ? J[i * SC + c] : 0.0;
+        FOR_COLS(cl, c, out[c] = c >= NXMAX ? J[i * SC + c] : 0.0;);
         for (int k = 0; k < n; ++k) {
             const double a = J[i * SC + k];
             if (a == 0.0) continue;
             const double *row = S + k * SC;
-            for (int c = 0; c < SC; ++c) out[c] += a * row[c];
+            FOR_COLS(cl, c, out[c] += a * row[c];);
         }
     }
 }
 
 /* One DOP853 step of (y, S) from (t0, y0, S) over h; S is overwritten, y1 gets the state. */
-static int sens_advance(int mode, const double *p, double t0, double h, const double *y0, double *S, double *y1) {
+static int sens_advance(int mode, const double *p, Cols cl, double t0, double h, const double *y0, double *S,
+                        double *y1) {
     const int n = MODE_NX[mode];
     double K[DOP_STAGES][NXMAX], KS[DOP_STAGES][NXMAX * SC], J[NXMAX * SC];
     double ytmp[NXMAX], Stmp[NXMAX * SC];
@@ -48,24 +65,25 @@ static int sens_advance(int mode, const double *p, double t0, double h, const do
             double acc = 0.0;
             for (int j = 0; j < st; ++j) acc += a[j] * K[j][i];
             ytmp[i] = y0[i] + h * acc;
+            FOR_COLS(cl, c, {
+                double as = 0.0;
+                for (int j = 0; j < st; ++j) as += a[j] * KS[j][i * SC + c];
+                Stmp[i * SC + c] = S[i * SC + c] + h * as;
+            });
         }
-        for (int e = 0; e < n * SC; ++e) {
-            double acc = 0.0;
-            for (int j = 0; j < st; ++j) acc += a[j] * KS[j][e];
-            Stmp[e] = S[e] + h * acc;
-        }
-        if (rhs_jac(mode, t0 + DOP_C[st] * h, ytmp, p, K[st], J)) return ST_SINGULAR_MASS;
-        jac_times(n, J, Stmp, KS[st]);
+        int err = sens_jac(mode, t0 + DOP_C[st] * h, ytmp, p, cl, K[st], J);
+        if (err) return err;
+        jac_times(n, cl, J, Stmp, KS[st]);
     }
     for (int i = 0; i < n; ++i) {
         double acc = 0.0;
         for (int j = 0; j < DOP_STAGES; ++j) acc += DOP_B[j] * K[j][i];
         y1[i] = y0[i] + h * acc;
-    }
-    for (int e = 0; e < n * SC; ++e) {
-        double acc = 0.0;
-        for (int j = 0; j < DOP_STAGES; ++j) acc += DOP_B[j] * KS[j][e];
-        S[e] += h * acc;
+        FOR_COLS(cl, c, {
+            double as = 0.0;
+            for (int j = 0; j < DOP_STAGES; ++j) as += DOP_B[j] * KS[j][i * SC + c];
+            S[i * SC + c] += h * as;
+        });
     }
     return 0;
 }
@@ -74,19 +92,21 @@ static int sens_advance(int mode, const double *p, double t0, double h, const do
  * fm to the flow just before the event (at the dense-output state x_ev; for a switching surface
  * extrapolated from its near side). */
 static int sens_to_event(const Dop *s, int mode, const double *p, double t0, const double *y0, double t_ev,
-                         const double *x_ev, int is_switch, double *S, double *fm) {
+                         const double *x_ev, int is_switch, double *sens, double *fm) {
+    const Cols cl = sens_cols(sens);
+    double *S = sens;
     const int n = MODE_NX[mode];
     const double span = t_ev - t0;
     double delta = fmax(1e-6 * span, 1e-9 * fmax(1.0, fabs(t_ev)));
     if (delta > 0.5 * span) delta = 0.5 * span;
     double ya[NXMAX], J[NXMAX * SC], KS[NXMAX * SC], fa[NXMAX];
     int st = 0;
-    if (span - delta > 0.0 && (st = sens_advance(mode, p, t0, span - delta, y0, S, ya))) return st;
+    if (span - delta > 0.0 && (st = sens_advance(mode, p, cl, t0, span - delta, y0, S, ya))) return st;
     if (!(span - delta > 0.0)) for (int i = 0; i < n; ++i) ya[i] = y0[i];
     /* the bridge over the last δ: S += δ (J_x S + J_p) at the near-side state */
-    if (rhs_jac(mode, t_ev - delta, ya, p, fa, J)) return ST_SINGULAR_MASS;
-    jac_times(n, J, S, KS);
-    for (int e = 0; e < n * SC; ++e) S[e] += delta * KS[e];
+    if ((st = sens_jac(mode, t_ev - delta, ya, p, cl, fa, J))) return st;
+    jac_times(n, cl, J, S, KS);
+    for (int i = 0; i < n; ++i) FOR_COLS(cl, c, S[i * SC + c] += delta * KS[i * SC + c];);
     if (!is_switch) {
         if (rhs(mode, t_ev, x_ev, p, fm)) return ST_SINGULAR_MASS;
         return 0;
@@ -108,42 +128,41 @@ static int sens_to_event(const Dop *s, int mode, const double *p, double t0, con
 static int sens_jump(int mode, int k, int tr, int target, double t_ev, const double *x_ev, const double *p,
                      const double *fm, const double *fp, int terminal, double *sens) {
     const int n = MODE_NX[mode], nd = MODE_NX[target];
+    const Cols cl = sens_cols(sens);
     double G[NTR1 * SC], gd[NTR1], dtau[SC];
     surfaces_grad(mode, t_ev, x_ev, p, G);
     surfaces_dot(mode, t_ev, x_ev, fm, p, gd);
     double *S = sens;
     const double *g = G + k * SC;
     if (!(fabs(gd[k]) > 0.0)) { /* grazing: the event time does not depend smoothly on the data */
-        for (int e = 0; e < NXMAX * SC + SC; ++e) sens[e] = NAN;
+        for (int e = 0; e < SENS_NCS; ++e) sens[e] = NAN;
         return 0;
     }
-    for (int c = 0; c < SC; ++c) {
+    FOR_COLS(cl, c, {
         double acc = c >= NXMAX ? g[c] : 0.0;
         for (int i = 0; i < n; ++i) acc += g[i] * S[i * SC + c];
         dtau[c] = -acc / gd[k];
-    }
-    if (tr >= 0) for (int c = 0; c < SC; ++c) sens[SENS_TAU + c] = dtau[c];
+    });
+    if (tr >= 0) FOR_COLS(cl, c, sens[SENS_TAU + c] = dtau[c];);
     if (terminal) return 0;
     double Y[NXMAX * SC], Sn[NXMAX * SC];
-    for (int i = 0; i < n; ++i)
-        for (int c = 0; c < SC; ++c) Y[i * SC + c] = S[i * SC + c] + fm[i] * dtau[c];
+    for (int i = 0; i < n; ++i) FOR_COLS(cl, c, Y[i * SC + c] = S[i * SC + c] + fm[i] * dtau[c];);
     if (tr < 0) {
-        for (int i = 0; i < n; ++i)
-            for (int c = 0; c < SC; ++c) Sn[i * SC + c] = Y[i * SC + c] - fp[i] * dtau[c];
+        for (int i = 0; i < n; ++i) FOR_COLS(cl, c, Sn[i * SC + c] = Y[i * SC + c] - fp[i] * dtau[c];);
     } else {
         double D[NXMAX * (SC + 1)];
         int err = reset_jac(tr, t_ev, x_ev, p, D);
         if (err) return ST_RESET_FAILED;
-        for (int a = 0; a < nd; ++a)
-            for (int c = 0; c < SC; ++c) {
-                const double *Da = D + a * (SC + 1);
+        for (int a = 0; a < nd; ++a) {
+            const double *Da = D + a * (SC + 1);
+            FOR_COLS(cl, c, {
                 double acc = Da[SC] * dtau[c] - fp[a] * dtau[c] + (c >= NXMAX ? Da[c] : 0.0);
                 for (int i = 0; i < n; ++i) acc += Da[i] * Y[i * SC + c];
                 Sn[a * SC + c] = acc;
-            }
+            });
+        }
     }
-    for (int e = 0; e < NXMAX * SC; ++e) S[e] = 0.0;
-    for (int e = 0; e < nd * SC; ++e) S[e] = Sn[e];
+    for (int a = 0; a < nd; ++a) FOR_COLS(cl, c, S[a * SC + c] = Sn[a * SC + c];);
     return 0;
 }
 
