@@ -42,11 +42,11 @@ def run(quick: bool = False) -> Section:
         d = len(S)
         reps = 5 if quick else 15
         plain, exact, fd = _median_interleaved(
-            [lambda: P(x),
-             lambda: np.linalg.eigvals(P.section_jacobian(x, "exact")[0]),
-             lambda: np.linalg.eigvals(P.section_jacobian(x, "fd")[0])], reps)
+            [lambda P=P, x=x: P(x),
+             lambda P=P, x=x: np.linalg.eigvals(P.section_jacobian(x, "exact")[0]),
+             lambda P=P, x=x: np.linalg.eigvals(P.section_jacobian(x, "fd")[0])], reps)
         # section_jacobian also finds the section's chart (one recorded run): time it alone
-        (chart,) = _median_interleaved([lambda: P.section_basis(x)], reps)
+        (chart,) = _median_interleaved([lambda P=P, x=x: P.section_basis(x)], reps)
         r_exact = (exact.median - chart.median) / plain.median
         r_fd = (fd.median - chart.median) / plain.median
         rows.append([name, d, f"{plain.median * 1e3:.3f}", f"{r_exact:.2f}", f"{r_fd:.2f}", 2 * d,

@@ -20,7 +20,7 @@ from ..derivation.equations import derive
 from ..derivation.impact import impulse_data
 from ..derivation.switching import switching_surfaces
 from ..modelling.hybrid import Explicit, HybridSystem, target_exprs
-from ..modelling.model import Model, t
+from ..modelling.model import t
 from . import abi
 from .codegen_support import ModeInfo
 from .codegen_support import Printer as _Printer

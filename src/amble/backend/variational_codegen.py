@@ -86,15 +86,18 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
     # ∂q̈ = M⁻¹ (∂F − ∂M q̈), ∂M symmetric (its lower triangle was differentiated)
     code += f"    for (int i = 0; i < {n}; ++i)\n        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
     code += f"            double r = dF[i * {nv} + v];\n"
-    code += f"            for (int l = 0; l < {n}; ++l) r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n"
+    code += (f"            for (int l = 0; l < {n}; ++l)\n"
+             f"                r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n")
     code += f"            dF[i * {nv} + v] = r;\n        }}\n"
     code += f"    amble_chol_apply({n}, M, dF, {nv});\n"
     code += f"    for (int i = 0; i < {n}; ++i) {{\n"
     if of_params:
-        code += f"        for (int v = 0; v < {len(inputs)}; ++v) {{ J[i * SC + {col}] = 0.0; J[({n} + i) * SC + {col}] = dF[i * {nv} + v]; }}\n"
+        code += (f"        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
+                 f"            J[i * SC + {col}] = 0.0;\n            J[({n} + i) * SC + {col}] = dF[i * {nv} + v];\n        }}\n")
     else:
         code += f"        dx[i] = x[{n} + i];\n        dx[{n} + i] = f[i];\n"
-        code += f"        for (int v = 0; v < {2 * n}; ++v) {{ J[i * SC + v] = v == {n} + i; J[({n} + i) * SC + v] = dF[i * {nv} + v]; }}\n"
+        code += (f"        for (int v = 0; v < {2 * n}; ++v) {{\n"
+                 f"            J[i * SC + v] = v == {n} + i;\n            J[({n} + i) * SC + v] = dF[i * {nv} + v];\n        }}\n")
     code += "    }\n    return 0;\n}\n"
     return code
 
@@ -126,7 +129,8 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
     m = src.model
     n = len(m.q)
     if tr.reset is None:  # identity
-        body = f"    for (int a = 0; a < {2 * n}; ++a) {{\n        for (int j = 0; j <= SC; ++j) D[a * (SC + 1) + j] = 0.0;\n"
+        body = (f"    for (int a = 0; a < {2 * n}; ++a) {{\n"
+                "        for (int j = 0; j <= SC; ++j) D[a * (SC + 1) + j] = 0.0;\n")
         body += "        D[a * (SC + 1) + a] = 1.0;\n    }\n    return 0;\n"
         return head + body + "}\n"
     dst = modes[tr.target]
@@ -153,7 +157,8 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
     code = head + clear
     code += f"    double Me[{ne * ne}], Jc[{nc * ne}], T[{nd * n}], u[{ne}], lam[{nc}];\n"
     code += f"    double dMe[{ne * ne * nv}], dJc[{nc * ne * nv}], dqn[{nd * nv}], dT[{nd * n * nv}], B[{nk * nv}];\n"
-    code += "    memset(dMe, 0, sizeof dMe); memset(dJc, 0, sizeof dJc); memset(dqn, 0, sizeof dqn); memset(dT, 0, sizeof dT);\n"
+    code += "    memset(dMe, 0, sizeof dMe);\n    memset(dJc, 0, sizeof dJc);\n"
+    code += "    memset(dqn, 0, sizeof dqn);\n    memset(dT, 0, sizeof dT);\n"
     code += jacobian_block([e for _, _, e in ent], [v for v, _, _ in ent],
                            lambda o, j: f"{ent[o][1][0]}[{ent[o][1][1] * nv + j}]", inputs, names, defs=defs)
     code += f"    for (int j = 0; j < {ne}; ++j) u[j] = j < {n} ? x[{n} + j] : 0.0;\n"
@@ -162,7 +167,8 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
     code += f"    for (int v = 0; v < {nv}; ++v) {{\n"
     code += f"        for (int a = 0; a < {ne}; ++a) {{\n"
     code += f"            double r = (v >= {n} && v < {2 * n}) ? Me[a * {ne} + v - {n}] : 0.0;\n"
-    code += f"            for (int b = 0; b < {ne}; ++b) r += dMe[(a * {ne} + b) * {nv} + v] * ((b < {n} ? x[{n} + b] : 0.0) - u[b]);\n"
+    code += (f"            for (int b = 0; b < {ne}; ++b)\n"
+             f"                r += dMe[(a * {ne} + b) * {nv} + v] * ((b < {n} ? x[{n} + b] : 0.0) - u[b]);\n")
     code += f"            for (int q = 0; q < {nc}; ++q) r += dJc[(q * {ne} + a) * {nv} + v] * lam[q];\n"
     code += f"            B[a * {nv} + v] = r;\n        }}\n"
     code += f"        for (int q = 0; q < {nc}; ++q) {{\n            double r = 0.0;\n"
@@ -171,7 +177,8 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
     code += f"    err = amble_kkt_solve_columns({ne}, {nc}, Me, Jc, B, {nv});\n    if (err) return err;\n"
     code += f"    static const int col[{nv}] = {{{', '.join(cols)}}};\n"
     code += f"    for (int v = 0; v < {nv}; ++v)\n        for (int a = 0; a < {nd}; ++a) {{\n"
-    code += f"            double s = 0.0;\n            for (int b = 0; b < {n}; ++b) s += dT[(a * {n} + b) * {nv} + v] * u[b] + T[a * {n} + b] * B[b * {nv} + v];\n"
+    code += (f"            double s = 0.0;\n            for (int b = 0; b < {n}; ++b)\n"
+             f"                s += dT[(a * {n} + b) * {nv} + v] * u[b] + T[a * {n} + b] * B[b * {nv} + v];\n")
     code += f"            D[a * (SC + 1) + col[v]] = dqn[a * {nv} + v];\n"
     code += f"            D[({nd} + a) * (SC + 1) + col[v]] = s;\n        }}\n    return 0;\n}}\n"
     return code

@@ -147,7 +147,8 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         if lc.requested_period and lc.requested_period != lc.period:
             print(f"{args.model}: the period-{lc.requested_period} search converged to a period-{lc.period} gait")
         print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
-              f"{'mean ' if lc.period > 1 else ''}step time {lc.step_time:.6g} {unit} (residual {lc.residual:.1e}, {lc.iterations} iterations)")
+              f"{'mean ' if lc.period > 1 else ''}step time {lc.step_time:.6g} {unit} "
+              f"(residual {lc.residual:.1e}, {lc.iterations} iterations)")
         if lc.period == 1:
             print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
         else:  # every point of the orbit and the time of every step: the mean alone hides the alternation
@@ -221,7 +222,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)
-    lc.add_argument("--period", type=int, default=1, help="k for a period-k gait (default 1); all k points and step times are reported")
+    lc.add_argument("--period", type=int, default=1,
+                    help="k for a period-k gait (default 1); all k points and step times are reported")
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
