@@ -93,11 +93,13 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
     code += f"    for (int i = 0; i < {n}; ++i) {{\n"
     if of_params:
         code += (f"        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
-                 f"            J[i * SC + {col}] = 0.0;\n            J[({n} + i) * SC + {col}] = dF[i * {nv} + v];\n        }}\n")
+                 f"            J[i * SC + {col}] = 0.0;\n"
+                 f"            J[({n} + i) * SC + {col}] = dF[i * {nv} + v];\n        }}\n")
     else:
         code += f"        dx[i] = x[{n} + i];\n        dx[{n} + i] = f[i];\n"
         code += (f"        for (int v = 0; v < {2 * n}; ++v) {{\n"
-                 f"            J[i * SC + v] = v == {n} + i;\n            J[({n} + i) * SC + v] = dF[i * {nv} + v];\n        }}\n")
+                 f"            J[i * SC + v] = v == {n} + i;\n"
+                 f"            J[({n} + i) * SC + v] = dF[i * {nv} + v];\n        }}\n")
     code += "    }\n    return 0;\n}\n"
     return code
 
