@@ -161,7 +161,11 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         w(f"    (void)t; (void)x; (void)p;\n    return ({cond}) ? 1 : 0;\n}}\n")
         w(_reset_code(i, tr, src, modes, nm, params))
 
-    # derivatives for sensitivity runs: flow Jacobians, surface gradients, reset Jacobians
+    # derivatives for sensitivity runs: flow Jacobians, surface gradients, reset Jacobians. Their
+    # straight-line code is an order of magnitude longer than the right-hand side's, and GCC's
+    # optimiser is superlinear in the length of a basic block (humanoid-3d: 8 s → 63 s at -O2);
+    # unoptimised they compile in seconds and cost a sensitivity run about 2× more
+    w("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC push_options\n#pragma GCC optimize (\"O0\")\n#endif\n")
     for name, mi in modes.items():
         nm = _names(mi.model, params)
         surf = [sp.sympify(tr.guard.expr) for tr in trs_by_mode[name]] + list(switches[name])
@@ -169,6 +173,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         w(surfaces_gradient_code(mi, surf, nm, params))
     for i, tr in enumerate(order):
         w(reset_jacobian_code(i, tr, modes[tr.source], modes, _names(modes[tr.source].model, params), params))
+    w("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC pop_options\n#endif\n")
 
     # dispatchers
     def dispatch(sig: str, ret: str, call: str, names: list[str], key: str) -> None:

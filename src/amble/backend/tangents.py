@@ -136,8 +136,12 @@ def jacobian_block(exprs: Sequence[sp.Expr], value_targets: Sequence[str | None]
     their non-zero partial derivatives, ``jacobian_target(o, i)`` ← ``∂exprs[o]/∂inputs[i]``.
     The caller zero-fills the Jacobian targets first. ``defs`` are named intermediate quantities
     (in order) that the expressions may use."""
-    prog = _Program(names, inputs, defs, indent)
-    nodes = [prog.node(e) for e in exprs]
+    # sympy's common-subexpression pass first (it also finds shared sub-products and sub-sums,
+    # which the DAG alone does not): its intermediates become named definitions, whose small
+    # expressions are differentiated node by node
+    repl, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols("c_"), order="none")
+    prog = _Program(names, inputs, [*defs, *repl], indent)
+    nodes = [prog.node(e) for e in reduced]
     for tgt, nd in zip(value_targets, nodes):
         if tgt is not None:
             prog.lines.append(f"{indent}{tgt} = {nd.value};")
