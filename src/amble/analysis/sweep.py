@@ -7,8 +7,7 @@ This module gathers the public API of the sweep feature; each idea lives in its 
 - :mod:`amble.analysis.runner` — Dask clients (:func:`open_client`) and chunked execution;
 - :mod:`amble.analysis.fixed_points` — fixed-point branches (continuation) and 2D maps,
   :func:`period_doubling`;
-- :mod:`amble.analysis.bifurcation` — bifurcation diagrams, :func:`poincare_iterates`,
-  :func:`on_section`;
+- :mod:`amble.analysis.bifurcation` — bifurcation diagrams, :func:`poincare_iterates`;
 - :mod:`amble.analysis.basin` — basins of attraction;
 
 Work is cut into chunks (consecutive parameter values, one row of a map or a basin), each one
@@ -24,12 +23,12 @@ Units: angles in rad, angular velocities in rad/s, times in s; parameters in the
 
 from __future__ import annotations
 
-from .basin import BASIN_LABELS, BasinResult, SetCoordinates, basin
-from .bifurcation import bifurcation, first_period_doubling_iterates, on_section, poincare_iterates
+from .basin import BASIN_LABELS, BasinResult, basin
+from .bifurcation import bifurcation, first_period_doubling_iterates, poincare_iterates
 from .fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from .runner import open_client
 from .store import ResultStore, SweepResult
 
-__all__ = ["BASIN_LABELS", "BasinResult", "ResultStore", "SetCoordinates", "SweepResult", "basin", "bifurcation",
-           "first_period_doubling_iterates", "on_section", "open_client", "period_doubling", "poincare_iterates",
+__all__ = ["BASIN_LABELS", "BasinResult", "ResultStore", "SweepResult", "basin", "bifurcation",
+           "first_period_doubling_iterates", "open_client", "period_doubling", "poincare_iterates",
            "sweep_fixed_points", "sweep_fixed_points_2d"]
