@@ -18,7 +18,8 @@ vector of ``[F_x F_λ]``), predict ``u + hτ`` and correct by Newton on
 
 whose Jacobian ``[[F_x, F_λ], [τᵀ]]`` stays regular through a fold, where the branch turns back
 in λ. The step ``h`` grows by 1.5 after a correction of ≤ 3 Newton iterations and is halved after
-a failed one; a step's change of λ is capped so the branch is drawn finely enough.
+a failed one; a step's change of λ is capped (``max_delta``) and so is its length in the state
+(3·max_delta·(1 + |x|∞)), so that the branch is drawn finely where it is steep in λ.
 
 **Test functions.** With ``A = Uᵀ (∂P/∂x) U`` (``U`` an orthonormal basis of Σ's tangent space,
 :meth:`Section.tangent`; ``A``'s eigenvalues are the multipliers, whatever the basis)
@@ -264,10 +265,13 @@ def _trace(prob: _Problem, u: np.ndarray, start: float, stop: float, max_delta: 
     pt = first or prob.point(u, J, res, 0.0)
     br.points.append(pt)
     tests = _tests(prob.reduced(u, J))
-    h = dmax / max(abs(t[-1]), 1e-3)
+    # the arclength step: the parameter moves at most dmax per step, the state at most about
+    # 3·dmax·(1 + |x|) (where the branch is steep in λ, near a fold or a pitchfork's root)
+    hmax = 3 * dmax * (1 + float(np.max(np.abs(u[:-1]))))
+    h = min(dmax / max(abs(t[-1]), 1e-12), hmax)
     hmin = 1e-8 * h
     while len(br.points) < max_points:
-        h = min(h, dmax / max(abs(t[-1]), 1e-12))
+        h = min(h, dmax / max(abs(t[-1]), 1e-12), hmax)
         try:
             un, Jn, resn, it = _correct(prob, u + h * t, t, tol)
         except AmbleError as e:  # ConvergenceError, SimulationError (a fall, a grazing event)
@@ -299,7 +303,7 @@ def _trace(prob: _Problem, u: np.ndarray, start: float, stop: float, max_delta: 
         if not lo < u[-1] < hi:
             br.end = "reached the end of the range"
             break
-        h = min(1.5 * h, 10 * dmax / max(abs(t[-1]), 1e-12)) if it <= 3 else h
+        h = 1.5 * h if it <= 3 else h
     else:
         br.end = f"{max_points} points"
     return br
