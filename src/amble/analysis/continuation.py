@@ -87,12 +87,17 @@ class BranchPoint:
 
 @dataclass
 class BifurcationPoint:
-    """A fold (a real multiplier through +1) or a flip (one through −1) located on a branch:
-    ``kind`` ``"fold"`` or ``"flip"``, the gait there (``point``) and the test function's value."""
+    """A fold (a real multiplier through +1: a turning point of the branch, or a branch point
+    such as a period-1 orbit continued as a 2-step fixed point at its flip) or a flip (one
+    through −1) located on a branch: ``kind`` ``"fold"`` or ``"flip"``, the gait there
+    (``point``) and the test function's value."""
 
     kind: str
     point: BranchPoint
     test: float
+    #: False when the location failed (e.g. the corrector at a branch point, where two branches
+    #: cross): ``point`` is then the bracketing branch point with the smaller |test|
+    located: bool = True
 
     @property
     def value(self) -> float:
@@ -245,8 +250,7 @@ def continue_branch(
     prob = _Problem(system, params, param, period, rtol, atol)
     base = {**dict(params or {}), param: start}
     lc = find_fixed_point(system, guess, params=base, period=period, rtol=rtol, atol=atol, tol=tol)
-    if lc.period != period:
-        raise ConvergenceError(f"the gait found at {param} = {start} has period {lc.period}, not {period}")
+    # a period-k search may land on a period-d orbit (d | k): it is continued as a k-step fixed point
     return _trace(prob, np.r_[lc.fixed_point, start], start, stop, max_delta, max_points, tol, locate,
                   system.name, param, None)
 
@@ -297,7 +301,11 @@ def _trace(prob: _Problem, u: np.ndarray, start: float, stop: float, max_delta: 
         if locate:
             for kind, a, b in (("fold", tests[0], testn[0]), ("flip", tests[1], testn[1])):
                 if a * b < 0:
-                    br.bifurcations.append(_locate(prob, u, un, kind, tol))
+                    try:
+                        br.bifurcations.append(_locate(prob, u, un, kind, tol))
+                    except AmbleError:
+                        near = (br.points[-1], a) if abs(a) < abs(b) else (ptn, b)
+                        br.bifurcations.append(BifurcationPoint(kind, near[0], near[1], located=False))
         br.points.append(ptn)
         u, t, tests = un, tn, testn
         if not lo < u[-1] < hi:

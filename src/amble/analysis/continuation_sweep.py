@@ -56,7 +56,9 @@ def branch_rows(b: int, br: Branch, snames: Sequence[str]) -> list[dict[str, Any
     rows = [_row(b, "point", i, br.param, br.period, pt, snames) for i, pt in enumerate(br.points)]
     if rows:
         rows[-1]["reason"] = br.end  # why the branch ended, on its last point
-    rows += [_row(b, bf.kind, i, br.param, br.period, bf.point, snames, bf.test) for i, bf in enumerate(br.bifurcations)]
+    rows += [{**_row(b, bf.kind, i, br.param, br.period, bf.point, snames, bf.test),
+              "reason": "" if bf.located else "not located: the nearest branch point"}
+             for i, bf in enumerate(br.bifurcations)]
     return rows
 
 
