@@ -5,9 +5,9 @@ One row per branch point and one per located bifurcation. Key ``branch, row, i``
 is the period-1 branch, ``branch`` b + 1 the period-doubled branch born at the first flip of
 branch b; ``row`` is ``point``, ``fold`` or ``flip``; ``i`` counts along the branch (points in
 the order traced, bifurcations in the order found). Continuation is sequential and deterministic,
-so it runs in this process (no Dask); each branch's rows are durable in the file when the branch
-is done, and a rerun on the same file keeps the stored rows and adds the missing ones (a complete
-file is left as it is).
+so it runs in this process (no Dask) and its rows are written when the branches are done; a rerun
+on the same file keeps the stored rows and adds missing ones, and a file holding another
+continuation (rows this one does not have, or another start) is refused with ``OutputError``.
 
 Units: the parameter in its own units, states in the model's (rad, rad/s), times in s.
 """
@@ -21,11 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import AmbleError
+from ..errors import AmbleError, OutputError
 from ..modelling.hybrid import HybridSystem
 from .continuation import Branch, BranchPoint, cascade
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
-from .store import ResultStore, SweepResult, state_columns
+from .runner import sweep_values
+from .store import ResultStore, SweepResult, fmt_value, state_columns
 from .sweep_runner import compiled
 
 
@@ -88,6 +89,7 @@ def sweep_continuation(
     ``SweepResult.params`` is ``[param]``.
     """
     _, _, snames = compiled(system, params, [param])
+    sweep_values([start, stop], param, system)  # finite, inside the parameter's domain
     cols = continuation_columns(param, snames)
     with ResultStore(out, list(cols), ["branch", "row", "i"]) as store:
         before = len(store.rows)
@@ -98,6 +100,12 @@ def sweep_continuation(
         except AmbleError as e:
             rows = [{"branch": 0, "row": "point", "i": 0, param: start, "status": "failed",
                      "reason": f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"}]
+        # a file of another continuation (other range, parameters or model) is refused, not mixed in
+        store.check_keys([tuple(fmt_value(r[c]) for c in ("branch", "row", "i")) for r in rows])
+        first = store.rows.get(("0", "point", "0"))
+        if first is not None and first[param] != fmt_value(start):
+            raise OutputError(f"{str(out)!r} holds a continuation from {param} = {first[param]}, not {start}; "
+                              f"use another file")
         store.append(rows)
         store.compact()
         return SweepResult(kind="continuation", params=[param], rows=store.sorted_rows(),
