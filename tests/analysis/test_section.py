@@ -83,3 +83,18 @@ def test_humanoid_3d_basin_50_by_50_completes(tmp_path):
     c = res.counts()
     assert sum(c.values()) == 2500 and c["failed"] == 0
     assert c["converged"] > 100
+
+
+def test_analysis_knows_no_coordinate_or_parameter_names():
+    """The section comes from guards and resets: no module of the analysis layer names a walker's
+    coordinate or parameter (the removed rule keyed on ``stance``, ``swing`` and ``slope``)."""
+    import re
+    from pathlib import Path
+
+    import amble.analysis as pkg
+
+    for f in Path(pkg.__file__).parent.glob("*.py"):
+        code = f.read_text(encoding="utf-8")
+        assert not re.search(r"""["'](slope|stance|swing)(_dot)?["']""", code), f.name
+    assert not hasattr(__import__("amble.analysis.bifurcation", fromlist=["x"]), "on_section")
+    assert not hasattr(__import__("amble.analysis.basin", fromlist=["x"]), "SetCoordinates")
