@@ -1,8 +1,8 @@
 """Bifurcation diagrams and Poincaré iterates: where the period-1 gait gives way to period 2, 4...
 
 Along a swept parameter the return map is iterated from the previous value's last post-impact
-state (first put on the new value's section, :meth:`~amble.analysis.section.Section.project`): a transient is dropped, then
-the iterates of one coordinate are kept and their period is read off. Unlike a fixed-point
+state (first put on the new value's section, :meth:`~amble.analysis.section.Section.project`): a
+transient is dropped, then the iterates of one coordinate are kept and their period is read off. Unlike a fixed-point
 branch this follows the *attractor*, so it shows the period-doubling cascade and where the
 walker falls.
 
@@ -144,8 +144,9 @@ def bifurcation(
     post-impact state, then ``keep`` more steps whose post-impact ``coordinate`` (name or state index; default the
     first, the stance angle of a walker, rad) is kept. A chunk's first value starts on its
     period-1 fixed point when one is found (else the model's guess walked in); a carried state
-    is first put on the new section, its section coordinates kept (:mod:`amble.analysis.section`). ``period`` in a row: smallest p with
-    iterates repeating within ``period_tol`` (0 = no period found: chaos or slow transient).
+    is first put on the new section, its section coordinates kept (:mod:`amble.analysis.section`).
+    ``period`` in a row: smallest p with iterates repeating within ``period_tol`` (0 = no period
+    found: chaos or slow transient).
     A value where the walker falls is recorded ``failed`` with the reason.
     """
     v = sweep_values(values, param, system)

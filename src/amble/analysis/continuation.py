@@ -290,7 +290,7 @@ def _trace(prob: _Problem, u: np.ndarray, start: float, stop: float, max_delta: 
             e = np.r_[np.zeros(prob.n), 1.0]
             try:
                 ue, Je, rese, _ = _correct(prob, u + (un - u) * (edge - u[-1]) / (un[-1] - u[-1]), e, tol,
-                                           extra=lambda v: (float(v[-1] - edge), e))
+                                           extra=lambda v, edge=edge, e=e: (float(v[-1] - edge), e))
             except AmbleError as ex:
                 br.end = f"the corrector failed at the range's end ({ex})"
                 break

@@ -1,5 +1,6 @@
 """Plots of parameter sweeps (matplotlib, Agg backend): bifurcation diagram, fixed-point branch
-with multiplier moduli, continued branches with their bifurcations, two-parameter stability map, basin of attraction, Poincaré iterates.
+with multiplier moduli, continued branches with their bifurcations, two-parameter stability map,
+basin of attraction, Poincaré iterates.
 
 Every function writes one figure to ``path`` (format from the suffix: .png, .svg or .pdf) and
 returns the path. Angles are in rad, angular velocities in rad/s; a swept parameter's unit is
