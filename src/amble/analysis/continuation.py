@@ -353,12 +353,15 @@ def _locate(prob: _Problem, ua: np.ndarray, ub: np.ndarray, kind: str, tol: floa
 
 
 def switch_at_flip(system: HybridSystem, flip: BifurcationPoint, param: str, stop: float, *,
-                   params: Mapping[str, float] | None = None, period: int | None = None,
+                   start: float | None = None, params: Mapping[str, float] | None = None, period: int | None = None,
                    amplitude: float = 1e-3, max_delta: float | None = None, max_points: int = 400,
                    rtol: float = FIXED_POINT_TOL, atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL,
                    locate: bool = True) -> Branch:
-    """The period-doubled branch born at a located flip, continued towards ``param = stop``.
+    """The period-doubled branch born at a located flip, continued away from it inside the
+    parameter range [start, stop] (default start: the flip's value).
 
+    A supercritical flip's period-doubled branch lies beyond the flip, a subcritical one's before
+    it (unstable): the branch goes wherever it lies, ending at the range's ends.
     ``period``: that of the branch the flip was found on (default: the flip's orbit length);
     the new branch has twice that. Its first gait is ``x* + εUv`` corrected with the amplitude
     ``ε = amplitude`` (state units) along the flip's eigenvector held fixed.
@@ -378,14 +381,14 @@ def switch_at_flip(system: HybridSystem, flip: BifurcationPoint, param: str, sto
     e = np.r_[v, 0.0]
     u1, J1, res, _ = _correct(prob, u + amplitude * e, e, tol,
                               extra=lambda z: (float(e @ (z - u)) - amplitude, e))
-    lo_hi = (min(lam, stop), max(lam, stop))
-    if not lo_hi[0] - 1e-12 <= u1[-1] <= lo_hi[1] + 1e-12:
-        raise ConvergenceError(f"the period-{2 * k0} branch at the flip {param} = {lam:.12g} lies on the other side "
-                               f"of it, away from {stop}")
+    first = lam if start is None else start
+    if not min(first, stop) <= u1[-1] <= max(first, stop):
+        raise ConvergenceError(f"the period-{2 * k0} branch born at the flip {param} = {lam:.12g} starts at "
+                               f"{u1[-1]:.12g}, outside the range {first}:{stop}")
     # continue away from the period-k branch: the tangent's component along v stays positive
     _, Jn = prob.F(u1)
     t = _null(Jn, e)
-    return _trace(prob, u1, lam, stop, max_delta, max_points, tol, locate, system.name, param, t)
+    return _trace(prob, u1, first, stop, max_delta, max_points, tol, locate, system.name, param, t)
 
 
 def cascade(system: HybridSystem, param: str, start: float, stop: float, *, levels: int = 3,
@@ -399,7 +402,8 @@ def cascade(system: HybridSystem, param: str, start: float, stop: float, *, leve
     while len(out) < levels and out[-1].flips():
         br = out[-1]
         try:
-            out.append(switch_at_flip(system, br.flips()[0], param, stop, params=params, period=br.period,
+            out.append(switch_at_flip(system, br.flips()[0], param, stop, start=start, params=params,
+                                      period=br.period,
                                       max_delta=max_delta, rtol=rtol, atol=atol, tol=tol))
         except AmbleError as e:
             br.end += f"; no period-{2 * br.period} branch ({e})"

@@ -188,7 +188,11 @@ def plot_continuation(result: Any, path: str | os.PathLike, *, coordinate: str |
                 o = np.asarray(json.loads(r["orbit"]))[:, ci]
                 a1.plot([float(r[pname])] * len(o), o, "^" if r["row"] == "fold" else "o", color="k", ms=5)
                 a2.axvline(float(r[pname]), color="0.6", lw=0.8)
-    a1.plot([], [], "o", color="k", ms=5, label="period doubling (flip)")
+    kinds = {r["row"] for r in ok}
+    if "flip" in kinds:
+        a1.plot([], [], "o", color="k", ms=5, label="period doubling (flip, μ = −1)")
+    if "fold" in kinds:
+        a1.plot([], [], "^", color="k", ms=5, label="fold (μ = +1)")
     a2.axhline(1.0, ls="--", color="k", lw=1)
     a2.set_yscale("log")
     a1.set_ylabel(f"post-impact {_label(coord)}" if coord else "post-impact state")
