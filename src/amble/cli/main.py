@@ -216,7 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.set_defaults(func=cmd_limit_cycle)
-    sw = add("sweep", "parameter sweep (fixed points, bifurcation diagram) or basin of attraction, on Dask")
+    sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
+                      "on Dask")
     model_args(sw, None)
     sw.add_argument("--kind", choices=("fixed-point", "continuation", "bifurcation", "basin"), default="fixed-point",
                     help="the fixed point on a grid of parameter values (default), pseudo-arclength "
