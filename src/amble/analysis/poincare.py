@@ -30,6 +30,8 @@ from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .section import Section
+from .section import chart as _chart
 
 
 @dataclass
@@ -168,35 +170,7 @@ class ReturnMap:
 
     def section_basis(self, x: np.ndarray) -> np.ndarray:
         """Orthonormal basis (n × d) of the section's tangent space near the image of ``x``."""
-        tr, t, xpre = self.last_impact(x)
-        k = self.k
-        src = k.mode_index(k.meta["transitions"][tr]["source"])
-        gi = [j for j, info in enumerate(k.meta["transitions"]) if info["source"] == k.meta["modes"][src]].index(tr)
-        grad = k.surface_gradients(src, t, xpre, self.p)[0][gi]
-        N = np.linalg.svd(grad[None, :])[2][1:].T  # null space of the guard gradient
-        DR = k.reset_jacobian(tr, t, xpre, self.p)[0]
-        T = DR @ N
-        U, s, _ = np.linalg.svd(T, full_matrices=False)
-        d = int(np.sum(s > 1e-7 * s[0]))
-        return U[:, :d]
-
-
-def _chart(U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Coordinates that chart the tangent space best, and the map from their increments to states."""
-    # pivoted Gram–Schmidt on the rows of U (= QR with column pivoting of Uᵀ): pick, one at a
-    # time, the state coordinate whose tangent row is least explained by those already picked
-    R = U.copy()
-    piv: list[int] = []
-    for _ in range(U.shape[1]):
-        norms = np.linalg.norm(R, axis=1)
-        norms[piv] = -1.0
-        j = int(np.argmax(norms))
-        piv.append(j)
-        v = R[j] / np.linalg.norm(R[j])
-        R = R - np.outer(R @ v, v)
-    S = np.sort(np.array(piv))
-    E = U @ np.linalg.inv(U[S, :])  # n × d: increment of the chart coordinates → tangent vector
-    return S, E
+        return Section.of(self, x).tangent()
 
 
 def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, method: str = "exact",

@@ -228,18 +228,22 @@ def build_parser() -> argparse.ArgumentParser:
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.set_defaults(func=cmd_limit_cycle)
-    sw = add("sweep", "parameter sweep (fixed points, bifurcation diagram) or basin of attraction, on Dask")
+    sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
+                      "on Dask")
     model_args(sw, None)
-    sw.add_argument("--kind", choices=("fixed-point", "bifurcation", "basin"), default="fixed-point",
-                    help="continuation of the fixed point (default), post-transient iterates (bifurcation), "
-                         "or which initial post-impact states walk into the gait (basin)")
+    sw.add_argument("--kind", choices=("fixed-point", "continuation", "bifurcation", "basin"), default="fixed-point",
+                    help="the fixed point on a grid of parameter values (default), pseudo-arclength "
+                         "continuation with folds, period doublings and the period-doubled branches "
+                         "(continuation), post-transient iterates (bifurcation), or which initial "
+                         "post-impact states walk into the gait (basin)")
     sw.add_argument("--param", action="append", metavar="NAME=START:STOP:COUNT",
                     help="swept parameter: give one for a branch or bifurcation diagram, two for a 2D map "
-                         "(fixed-point and bifurcation kinds)")
+                         "(fixed-point and bifurcation kinds); --kind continuation: NAME=START:STOP[:STEPS], "
+                         "STEPS (default 50) bounding the parameter change per step by |STOP-START|/STEPS")
     sw.add_argument("--x", action="append", metavar="NAME=START:STOP:COUNT",
                     help="--kind basin: a coordinate of the initial post-impact state, give exactly two "
                          "(e.g. --x stance=-0.4:0:100 --x stance_dot=0.5:1.6:100); the other coordinates "
-                         "come from the fixed point (compass-like walkers: swing = 2*slope - stance)")
+                         "come from the fixed point, the dependent ones from the post-impact section")
     sw.add_argument("--steps", type=int, default=None,
                     help=f"--kind basin: footfalls walked from each initial state at most (default {BASIN_STEPS})")
     sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")
