@@ -13,7 +13,7 @@ MIRROR = np.array([-1.0, 1.0, -1.0])  # angular momentum (a pseudovector) under 
 
 @pytest.fixture(scope="module")
 def humanoid():
-    return load("humanoid-3d")
+    return load("humanoid-3d-yaw")
 
 
 def _frame(q):
@@ -69,7 +69,7 @@ def test_upright_sagittal_start_is_attracted_to_the_default_gait(humanoid):
     x0 = [-0.2206, 0.3206, 0, 0, -0.0442, 0, 0, 0.971, 0.411, 0, 0, 0.464, 0, 0]
     tr = simulate(humanoid, x0, steps=50, sample_dt=0.0)
     assert tr.status == "completed"
-    assert np.allclose(tr.final_post_impact_state, humanoid.default_start["humanoid-3d"], atol=1e-6)
+    assert np.allclose(tr.final_post_impact_state, humanoid.default_start["humanoid-3d-yaw"], atol=1e-6)
 
 
 def test_stable_limit_cycle(humanoid):
