@@ -35,8 +35,9 @@ segment inertias). With every Φ and Φ̇ zero the model is humanoid-2d exactly.
 
 Control Γ (Eq. 40, entries in the coordinate order above): stance 0; stance_cor (τ_2), swing_cor
 (τ_5), torso_cor (τ_7): spring-dampers ``−k Φ − k_v Φ̇`` (the ``τ_i = k_i θ_i + k_vi θ̇_i`` of
-Eq. 40, signs chosen to restore): ``k_sc`` 400 N·m/rad, ``kv_sc`` 40 N·m·s/rad (below k_sc ≈ 250
-a real multiplier of the sideways fall of the stance leg leaves the unit circle), ``k_sw`` 50,
+Eq. 40, signs chosen to restore): ``k_sc`` 200 N·m/rad, ``kv_sc`` 40 N·m·s/rad (below k_sc ≈ 71
+a real multiplier of the sideways fall of the stance leg leaves the unit circle: −1.13 at 60,
+−2.06 at 0), ``k_sw`` 50,
 ``kv_sw`` 10, ``k_tc`` 100, ``kv_tc`` 10; torso (τ_6): humanoid-2d's PD ``kT (theta_d − torso) −
 kv torso_dot`` (``kT`` 100, ``kv`` 10, ``theta_d`` 0), between torso and stance leg as in
 humanoid-2d (the stance leg takes the reaction); thigh: humanoid-2d's step-length torque ``−kleg·L``
@@ -45,9 +46,11 @@ controller, and without it the sagittal gait has no fixed point, see humanoid-2d
 and all coronal gains 0 give the uncontrolled (conservative between impacts) robot.
 
 State (mode "unlocked"): ``stance stance_cor thigh shank swing_cor torso torso_cor`` then rates.
-Stable gait at the defaults (post-impact): humanoid-2d's gait with the coronal angles at zero —
-the thesis' remark that the 3D fixed points equal the 2D ones holds exactly for this symmetric
-model; the coronal modes add multipliers inside the unit circle (see the README table).
+Stable gait at the defaults (post-impact): humanoid-2d's gait with the coronal angles at zero,
+x* = (−0.22061, 0, 0.32061, 0.32061, 0, −0.04424, 0, 0.97088, 0, 0.41058, 0.41058, 0, 0.46373, 0);
+step 0.7827 s, the knee locking before heel strike — the thesis' remark that the 3D fixed points
+equal the 2D ones holds exactly for this left–right symmetric model. Multipliers: humanoid-2d's
+−0.325 ± 0.198i and 0.122, and the coronal modes' −0.192, 0.179, 0.011, … (all inside).
 """
 
 import sympy as sp
@@ -69,7 +72,7 @@ def build() -> Walker:
         mh=10.0, mt=3.5, ms=1.5, a1=0.25, b1=0.25, a2=0.15, b2=0.35, mT=3.0, lT=0.5, g=9.81, slope=0.05)
     kT, kv, theta_d, kleg = m.parameters(kT=100.0, kv=10.0, theta_d=0.0, kleg=5.0)
     k_sc, kv_sc, k_sw, kv_sw, k_tc, kv_tc = m.parameters(
-        k_sc=400.0, kv_sc=40.0, k_sw=50.0, kv_sw=10.0, k_tc=100.0, kv_tc=10.0)
+        k_sc=200.0, kv_sc=40.0, k_sw=50.0, kv_sw=10.0, k_tc=100.0, kv_tc=10.0)
     m.restrict("mh mt ms a1 b1 a2 b2 mT lT g", POSITIVE)
     m.restrict("kT kv kleg k_sc kv_sc k_sw kv_sw k_tc kv_tc", NONNEGATIVE)
     up = R3(st, st_c)
