@@ -97,6 +97,14 @@ def test_stable_limit_cycle_with_a_knee(humanoid):
     assert [e.name for e in tr.events] == ["knee_lock", "heel_strike"]  # the knee locks before heel strike
 
 
+def test_a_sideways_lean_and_sway_die_out(humanoid):
+    x0 = np.array(humanoid.fixed_point_guess)
+    x0[[1, 4, 6, 8, 11, 13]] += [0.03, -0.02, 0.05, -0.2, 0.3, 0.2]  # coronal angles and rates
+    tr = simulate(humanoid, x0, steps=30, sample_dt=0.0)
+    assert tr.status == "completed"
+    assert np.max(np.abs(tr.final_post_impact_state[[1, 4, 6, 8, 11, 13]])) < 1e-6
+
+
 def test_without_the_stance_roll_spring_the_sideways_fall_is_unstable(humanoid):
     lc = find_fixed_point(humanoid, params={"k_sc": 0.0})
     assert not lc.stable and np.sum(np.abs(lc.multipliers) > 1) == 1

@@ -37,7 +37,7 @@ Control Γ (Eq. 40, entries in the coordinate order above): stance 0; stance_cor
 (τ_5), torso_cor (τ_7): spring-dampers ``−k Φ − k_v Φ̇`` (the ``τ_i = k_i θ_i + k_vi θ̇_i`` of
 Eq. 40, signs chosen to restore): ``k_sc`` 200 N·m/rad, ``kv_sc`` 40 N·m·s/rad (below k_sc ≈ 71
 a real multiplier of the sideways fall of the stance leg leaves the unit circle: −1.13 at 60,
-−2.06 at 0), ``k_sw`` 50,
+|μ| = 2.06 at 0), ``k_sw`` 50,
 ``kv_sw`` 10, ``k_tc`` 100, ``kv_tc`` 10; torso (τ_6): humanoid-2d's PD ``kT (theta_d − torso) −
 kv torso_dot`` (``kT`` 100, ``kv`` 10, ``theta_d`` 0), between torso and stance leg as in
 humanoid-2d (the stance leg takes the reaction); thigh: humanoid-2d's step-length torque ``−kleg·L``
