@@ -1,4 +1,4 @@
-"""Humanoid in 3D (thesis Section 4.4, Eq. 34–40): two straight legs, a pelvis of width ``w``, a torso.
+"""Humanoid in 3D with pelvis yaw (thesis 4.4 without the knee): straight legs, a pelvis of width ``w``, a torso.
 
 Coordinates (absolute angles; every leg/torso direction is ``R3(Θ, Φ)``, Eq. 37)::
 
