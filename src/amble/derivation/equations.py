@@ -14,7 +14,7 @@ polynomially with the number of coordinates (see :meth:`Equations.count_ops`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import sympy as sp
 
@@ -39,6 +39,19 @@ class Equations:
     #: recursion): ``(definitions, M, h)``, definitions as ``(symbol, expression)`` in order —
     #: code generation prints these instead of searching the expanded ones for common parts
     compact: tuple[list[tuple[sp.Symbol, sp.Expr]], sp.Matrix, sp.Matrix] | None = None
+    #: the input matrix (n × nu; ``∂on_j/∂q`` per column) and the input symbols, in declaration order
+    B: sp.Matrix | None = None
+    inputs: list[sp.Symbol] = field(default_factory=list)
+    #: the closed-loop law of every input (nu × 1, zero where none; ``M`` and ``h`` substituted)
+    u: sp.Matrix | None = None
+
+    @cached_property
+    def closed_loop_force(self) -> sp.Matrix:
+        """``Γ + B u(q, q̇, t)``: the generalized force the compiled right-hand side uses
+        (``Gamma`` stays the passive force)."""
+        if self.B is None or self.B.cols == 0 or self.u is None:
+            return self.Gamma
+        return self.Gamma + self.B * self.u
 
     @property
     def q(self) -> list[sp.Symbol]:
@@ -205,8 +218,13 @@ def derive(model: Model) -> Equations:
         defs = model.tree.defs
         compact = (defs.needed([*Mt, *ht]), M + Mt, h + ht)
         M, h = M + defs.expand(Mt), h + defs.expand(ht)
+    B = model.input_matrix()
+    u = model.control_law
+    if model.derived_placeholders and u.rows:
+        subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
+        u = u.xreplace(subs)
     return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy,
-                     compact=compact)
+                     compact=compact, B=B, inputs=model.inputs, u=u)
 
 
 def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:
