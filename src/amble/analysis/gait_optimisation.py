@@ -174,6 +174,11 @@ def optimize_gait(
     lbg = np.concatenate([np.full(e.numel(), lo) for _, e, lo, _ in groups])
     ubg = np.concatenate([np.full(e.numel(), hi) for _, e, _, hi in groups])
     w0 = _start_vector(fns, x_guess, t_guess, N, P)
+    n_eq = int(np.sum(lbg == ubg))
+    if n_eq > w.numel():
+        pace = " and a speed or step length" if (speed or step_length) else ""
+        raise ParameterError(f"the gait is over-determined: {n_eq} equations for {w.numel()} unknowns (a model with "
+                             f"{nu} input(s){pace}); declare actuators or drop the speed or step length")
 
     opts = {"ipopt.tol": tol, "ipopt.constr_viol_tol": min(tol, 1e-10), "ipopt.max_iter": max_iter,
             "ipopt.print_level": 5 if progress else 0, "print_time": False, "ipopt.sb": "yes",
@@ -191,8 +196,10 @@ def optimize_gait(
     if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
         worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
         reason = _FAILURES.get(status, status.replace("_", " ").lower())
+        binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})" if worst[1]["max_violation"] > tol
+                   else "every constraint holds at the last iterate (the optimality conditions do not)")
         raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
-                          f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})")
+                          f"{binding}")
     return _gait(system, model, fns, pvals, wopt, N, objective, float(sol["f"]), report,
                  {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed,
                   "nodes": N}, bezier_degree)

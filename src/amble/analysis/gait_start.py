@@ -7,12 +7,15 @@ from typing import Any
 import numpy as np
 
 from ..backend.casadi_export import StepFunctions
-from ..errors import ParameterError, StateError
+from ..errors import ConvergenceError, ParameterError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.simulate import simulate
+from .poincare import default_guess
 
 #: step time (s) of a standing start when neither a step time nor a speed says otherwise
 STAND_STEP_TIME = 0.5
+#: passive steps walked from the system's guess before the step that starts an optimisation
+SETTLE_STEPS = 30
 
 
 def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, float], guess: Any, N: int,
@@ -20,8 +23,9 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
                   ) -> tuple[np.ndarray, float]:
     """States at the ``2N + 1`` collocation points and the step time (s) to start from.
 
-    ``guess`` ``None``/``"passive"``: one passive step from the system's fixed-point guess (or
-    default start); a state: one passive step from it; ``"stand"``: the first state of the
+    ``guess`` ``None``/``"passive"``: the passive walk from the system's fixed-point guess (or
+    default start) settled over a few steps (:func:`~amble.analysis.poincare.default_guess`: a
+    stable passive gait where there is one), then one step; a state: one passive step from it; ``"stand"``: the first state of the
     system's guess, held still with zero velocities. A passive step that does not end in a
     footfall falls back to standing in its first state.
     """
@@ -35,6 +39,11 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
         if start is None:
             raise StateError(f"system {system.name!r} has no fixed-point guess or start: give guess=<state>")
         x0 = np.asarray(start, float)
+        if guess != "stand" and len(x0) == 2 * n:
+            try:
+                x0 = np.asarray(default_guess(system, params, steps=SETTLE_STEPS), float)
+            except ConvergenceError:
+                pass  # walking does not settle: start from the guess itself
     else:
         x0 = np.asarray(guess, float)
     if x0.shape != (2 * n,) or not np.all(np.isfinite(x0)):

@@ -1,7 +1,7 @@
 """The ``amble`` command line: every command is one API call plus input/output.
 
 Exit codes: 0 success, 2 user error (bad model name, parameter, range, path...), 1 internal
-failure. Errors are one line on stderr, or ``{"error": ...}`` on stdout with ``--json``.
+failure or a solver that did not succeed (``SolverError``). Errors are one line on stderr, or ``{"error": ...}`` on stdout with ``--json``.
 """
 
 from __future__ import annotations
@@ -13,10 +13,11 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
-from ..errors import AmbleError
+from ..errors import AmbleError, SolverError
 from ..simulation.engine import Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .equations import cmd_equations
+from .gait import add_parser as add_gait_parser
 
 MODEL_HELP = ("a library model (see 'amble models') or a model file path/to/file.py[:callable]: the callable, "
               "else the file's build(), else the one HybridSystem it defines")
@@ -167,6 +168,7 @@ EXAMPLES = {
     "simulate": "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html",
     "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
     "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
+    "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
 }
 
 
@@ -238,6 +240,12 @@ def build_parser() -> argparse.ArgumentParser:
                          "worker processes)")
     sw.add_argument("--workers", type=int, default=None, help="local Dask worker processes (default: cores)")
     sw.set_defaults(func=cmd_sweep)
+
+    def model_arg(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("model", help=MODEL_HELP)
+        sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+
+    add_gait_parser(add, model_arg)
     return p
 
 
@@ -256,6 +264,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.json:
             print(json.dumps(result, default=_jsonable))
         return 0
+    except SolverError as e:  # the numbers did not work out (not a user error): one line, exit 1
+        if want_json:
+            print(json.dumps({"error": str(e), "type": type(e).__name__}))
+        print(f"amble: {e}", file=sys.stderr)
+        return 1
     except AmbleError as e:
         msg = str(e).splitlines()[0] if str(e) else type(e).__name__
         if want_json:
