@@ -18,7 +18,9 @@ post-impact extended velocity and impulse. The constraints are
   ``clearance · 4s(1 − s)`` above the ground at phase ``s = t/T``.
 
 Objectives, all per unit distance walked: ``effort`` ``(1/L) ∫ ‖u‖² dt``, ``cot`` (cost of
-transport) ``(1/(mₜ g L)) ∫ Σ |u_j v_j| dt`` with ``v = Bᵀq̇`` (smoothed), or a user expression
+transport) ``(1/(mₜ g L)) ∫ Σ |u_j v_j| dt`` with ``v = Bᵀq̇`` (each power split into its positive
+and negative parts, ``u_j v_j = p⁺ − p⁻``, ``p± ≥ 0``, so that ``|u_j v_j| = p⁺ + p⁻`` at the optimum
+without a kink), or a user expression
 ``c(q, q̇, u)``: ``(1/L) ∫ c dt``. CasADi builds the problem from amble's derived expressions
 (:mod:`amble.backend.casadi_export`) with exact sparse first and second derivatives; IPOPT solves it.
 """
@@ -42,8 +44,6 @@ from .gait_result import Gait, bezier_fit, constraint_report
 from .gait_start import initial_guess
 
 OBJECTIVES = ("effort", "cot")
-#: smoothing of |power| in the cost of transport (W): |x| ≈ √(x² + ε²) − ε
-COT_SMOOTHING = 1e-4
 
 _FAILURES = {
     "Infeasible_Problem_Detected": "the constraints are infeasible",
@@ -71,6 +71,7 @@ def optimize_gait(
     clearance: float | None = None,
     bounds: Mapping[str, tuple[float | None, float | None]] | None = None,
     bezier_degree: int = 5,
+    phase: Any = None,
     max_iter: int = 500,
     tol: float = 1e-10,
     progress: bool = False,
@@ -81,9 +82,12 @@ def optimize_gait(
     free). ``objective``: ``"effort"``, ``"cot"`` or an integrand (sympy expression or text in the
     model's coordinates, velocities, inputs and parameters). ``nodes``: collocation intervals.
     ``guess``: a post-impact state to start from (walked passively for one step where that
-    works), ``"passive"`` (the system's fixed-point guess walked one step; the default),
-    ``"stand"`` (standing still in the first state of the system's guess, with ``step_time``).
+    works), ``"passive"`` (the default: a passive step on the system's own gait), ``"stand"``
+    (standing still in the posture of the system's guess for ``step_time``) or ``"interpolate"``
+    (from that posture to the relabelled one); see :func:`~amble.analysis.gait_start.initial_guess`.
     ``bounds``: ``{state name: (low, high)}`` limits on coordinates or velocities at every point.
+    ``bezier_degree``, ``phase``: the Bézier virtual constraints reported with the gait (the phase
+    an expression of the coordinates, default the hip's distance ahead of the stance foot).
     ``progress``: solver iterations and constraint violation on stderr.
 
     Raises :class:`ParameterError` / :class:`StateError` / :class:`ModelError` on bad input and
@@ -104,10 +108,10 @@ def optimize_gait(
     pvals = _parameters(system, params)
     model = system.modes[system.mode_names[0]]
     integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
-    fns = step_functions(system, integrand)
+    fns = step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
     n, nu, d, N = fns.n, fns.nu, fns.dims, nodes
     P = np.array([pvals[k] for k in fns.param_names])
-    x_guess, t_guess = initial_guess(system, fns, pvals, guess, N, step_time, speed, step_length)
+    x_guess, t_guess = initial_guess(system, fns, pvals, guess, N, step_time)
 
     # ------------------------------------------------------------------ unknowns
     # MX with each model function mapped over the points: the graph holds one copy of each
@@ -115,7 +119,9 @@ def optimize_gait(
     K = 2 * N + 1
     X, A, U = ca.MX.sym("x", 2 * n, K), ca.MX.sym("a", n, K), ca.MX.sym("u", nu, K)
     Tv, QE, LAM = ca.MX.sym("T"), ca.MX.sym("qe", n + d), ca.MX.sym("lam", d)
-    w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM)
+    cot = isinstance(objective, str) and objective == "cot"
+    PW = ca.MX.sym("power", 2 * nu if cot else 0, K)  # positive and negative parts of each input's power
+    w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW))
     h = Tv / N
     taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
     Q, V = X[:n, :], X[n:, :]
@@ -159,9 +165,9 @@ def optimize_gait(
     if objective == "effort":
         run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
         scale = 1.0
-    elif objective == "cot":
-        run = (ca.sum1(ca.sqrt((U * fns.actuator_rates.map(K)(Q, V, P)) ** 2 + COT_SMOOTHING**2) - COT_SMOOTHING)
-               if nu else ca.MX.zeros(1, K))
+    elif cot:
+        add("power", U * fns.actuator_rates.map(K)(Q, V, P) - (PW[:nu, :] - PW[nu:, :]))
+        run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
         scale = 1.0 / float(fns.weight(P))
     else:
         run = fns.integrand.map(K)(Q, V, U, taus, P)
@@ -170,10 +176,11 @@ def optimize_gait(
 
     # ------------------------------------------------------------------ bounds
     lbw, ubw = _bounds(model, fns, bounds, N, t_guess)
+    lbw, ubw = np.concatenate([lbw, np.zeros(PW.numel())]), np.concatenate([ubw, np.full(PW.numel(), np.inf)])
     g = ca.vertcat(*[e for _, e, _, _ in groups])
     lbg = np.concatenate([np.full(e.numel(), lo) for _, e, lo, _ in groups])
     ubg = np.concatenate([np.full(e.numel(), hi) for _, e, _, hi in groups])
-    w0 = _start_vector(fns, x_guess, t_guess, N, P)
+    w0 = np.concatenate([_start_vector(fns, x_guess, t_guess, N, P), np.zeros(PW.numel())])
     n_eq = int(np.sum(lbg == ubg))
     if n_eq > w.numel():
         pace = " and a speed or step length" if (speed or step_length) else ""
@@ -218,18 +225,24 @@ def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dic
 
 
 def _integrand(model: Any, objective: Any) -> sp.Expr:
-    known = {str(s): s for s in [*model.q, *model.qd, *model.params, *(getattr(model, "inputs", []) or [])]}
-    if isinstance(objective, str):
+    return _expression(model, objective, "objective", [*model.qd, *(getattr(model, "inputs", []) or [])],
+                       "objectives: effort, cot, or an expression in ")
+
+
+def _expression(model: Any, text: Any, what: str, extra: Sequence[sp.Symbol] = (), hint: str = "") -> sp.Expr:
+    """A user expression (text or sympy) in the coordinates, parameters and ``extra`` symbols."""
+    known = {str(s): s for s in [*model.q, *model.params, *extra]}
+    if isinstance(text, str):
         try:
-            expr = sp.sympify(objective, locals=known)
+            expr = sp.sympify(text, locals=known)
         except (sp.SympifyError, SyntaxError, TypeError) as e:
-            raise ParameterError(f"objective {objective!r} is not 'effort', 'cot' or an expression ({e})") from None
+            raise ParameterError(f"{what} {text!r} is not an expression ({e})") from None
     else:
-        expr = sp.sympify(objective)
+        expr = sp.sympify(text)
     bad = sorted(str(s) for s in expr.free_symbols if str(s) not in known or known[str(s)] != s)
     if bad:
-        raise ParameterError(f"objective {objective!s} uses {', '.join(bad)}: not a coordinate, velocity, input "
-                             f"or parameter (objectives: effort, cot, or an expression in {', '.join(known)})")
+        raise ParameterError(f"{what} {text!s} uses {', '.join(bad)}: not among the allowed names "
+                             f"({hint}{', '.join(known)})")
     return expr
 
 
@@ -280,7 +293,8 @@ def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: 
     A = w[2 * n * K: 3 * n * K].reshape(K, n)
     U = w[3 * n * K: (3 * n + nu) * K].reshape(K, nu)
     T = float(w[(3 * n + nu) * K])
-    impulse = w[-fns.dims:]
+    base = (3 * n + nu) * K + 1 + n + fns.dims
+    impulse = w[base: base + fns.dims]
     P = np.array([pvals[k] for k in fns.param_names])
     L = float(fns.distance(X[-1, :n], P))
     return Gait(system=system.name, state_names=list(fns.state_names), input_names=list(fns.input_names),

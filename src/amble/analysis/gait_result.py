@@ -139,10 +139,10 @@ def bernstein(s: np.ndarray, degree: int) -> np.ndarray:
 
 def bezier_fit(model: Any, fns: StepFunctions, X: np.ndarray, degree: int, P: np.ndarray) -> dict[str, Any] | None:
     """HZD virtual constraints of the gait: each actuated quantity ``y_j = B_jᵀ q`` as a Bézier
-    polynomial of degree ``degree`` in the phase ``s = (θ − θ⁺)/(θ⁻ − θ⁺)`` (least squares over
-    the collocation points), ``θ = cᵀ q`` the unactuated direction of the coordinates (the one
-    orthogonal to every column of ``B``; with several, the first). Needs ``B`` constant (linear
-    actuated quantities) and ``θ`` monotone over the step; otherwise None."""
+    polynomial of degree ``degree`` in the phase ``s = (θ − θ⁺)/(θ⁻ − θ⁺)``, fitted by least
+    squares over the collocation points; ``θ(q)`` is :attr:`StepFunctions.phase` (``θ⁺``, ``θ⁻``
+    its values after and before the impact). Needs a constant ``B`` (actuated quantities linear
+    in ``q``) and ``θ`` strictly increasing over the step; otherwise None."""
     if fns.nu == 0 or degree < 1:
         return None
     n = fns.n
@@ -151,14 +151,7 @@ def bezier_fit(model: Any, fns: StepFunctions, X: np.ndarray, degree: int, P: np
     B = Bs[0]
     if any(np.abs(b - B).max() > 1e-12 * max(np.abs(B).max(), 1.0) for b in Bs):
         return None  # actuated quantities not linear in q: no single output map to report
-    _, sv, vt = np.linalg.svd(B.T)
-    null = vt[np.sum(sv > 1e-9 * max(sv.max(), 1.0)):]
-    if not len(null):
-        return None
-    c = null[0]
-    theta = Q @ c
-    if theta[-1] < theta[0]:
-        c, theta = -c, -theta
+    theta = np.array([float(fns.phase(q, P)) for q in Q])
     if np.any(np.diff(theta) <= 0):
         return None
     s = (theta - theta[0]) / (theta[-1] - theta[0])
@@ -168,5 +161,5 @@ def bezier_fit(model: Any, fns: StepFunctions, X: np.ndarray, degree: int, P: np
     outputs = [sp.sstr(sum((sp.Float(B[i, j], 12) * model.q[i] for i in range(n) if B[i, j] != 0), sp.Integer(0)))
                for j in range(fns.nu)]
     return {"degree": degree, "outputs": outputs, "inputs": list(fns.input_names),
-            "phase": {"coefficients": c.tolist(), "theta_plus": float(theta[0]), "theta_minus": float(theta[-1])},
+            "phase": {"expression": fns.phase_text, "theta_plus": float(theta[0]), "theta_minus": float(theta[-1])},
             "alpha": alpha.T.tolist(), "fit_error": float(np.abs(basis @ alpha - Y).max())}

@@ -182,7 +182,8 @@ class StepFunctions:
       conditions as values that must be ≥ 0 (empty without one);
     * ``distance(q, p)``: how far the impacting point is ahead of the stance foot along the slope (m);
     * ``normal(p)``: the slope's unit normal; ``actuator_rates(q, qd, p)``: ``Bᵀ q̇`` (rad/s or m/s);
-    * ``input_matrix(q, p)``: ``B`` (``n × nu``);
+    * ``input_matrix(q, p)``: ``B`` (``n × nu``); ``phase(q, p)``: the phase variable ``θ`` of the
+      gait's virtual constraints;
     * ``weight(p)``: ``mₜ |g|`` (N), the scale of the cost of transport.
     """
 
@@ -203,6 +204,8 @@ class StepFunctions:
     normal: Any
     actuator_rates: Any
     input_matrix: Any
+    phase: Any
+    phase_text: str
     integrand: Any = None
 
 
@@ -220,13 +223,16 @@ def _conditions(cond: Any) -> list[sp.Expr]:
     raise ModelError(f"enabling condition {c} is not a comparison (or a conjunction of comparisons)")
 
 
-def step_functions(system: Any, integrand: Any = None) -> StepFunctions:
+def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> StepFunctions:
     """Export one step of a one-mode walker (:class:`~amble.modelling.walker.Walker`) whose footfall
     is an :class:`~amble.modelling.hybrid.Impact` back into the same mode.
 
     ``integrand``: an optional sympy expression in the state, the inputs and the parameters,
-    exported as ``integrand(q, qd, u, t, p)``. Inputs and ``B`` come from the model's actuators
-    (``Equations.B``, ``Model.inputs``); a model without actuators has ``nu = 0``.
+    exported as ``integrand(q, qd, u, t, p)``. ``phase``: an expression of the coordinates that
+    grows over a step (default: the hip's distance ahead of the stance foot along the slope),
+    exported as ``phase(q, p)`` with its text in :attr:`StepFunctions.phase_text`. Inputs and
+    ``B`` come from the model's actuators (``Equations.B``, ``Model.inputs``); a model without
+    actuators has ``nu = 0``.
     """
     from ..derivation.equations import derive
     from ..derivation.impact import impulse_data
@@ -294,10 +300,16 @@ def step_functions(system: Any, integrand: Any = None) -> StepFunctions:
     distance = ca.Function("distance", [q, p], [T(dist)], ["q", "p"], ["distance"])
     normal = ca.Function("normal", [p], [T.matrix(nvec)], ["p"], ["n"])
     rates = ca.Function("actuator_rates", [q, qd, p], [T.matrix(B.T * sp.Matrix(m.qd)) if nu else ca.SX(0, 1)])
+    if phase is None:
+        hip = getattr(system, "hip", None)
+        point = m.points[hip] if hip is not None else foot
+        phase = sum((dvec[i] * point[i] for i in range(d)), sp.Integer(0))
+    phase_fn = ca.Function("phase", [q, p], [T(phase)], ["q", "p"], ["theta"])
     f_int = None
     if integrand is not None:
         f_int = ca.Function("integrand", [q, qd, u, tt, p], [T(integrand)])
     input_matrix = ca.Function("input_matrix", [q, p], [T.matrix(B) if nu else ca.SX(n, 0)], ["q", "p"], ["B"])
     weight = ca.Function("weight", [p], [T(mt) * ca.norm_2(T.matrix(m.gravity_vector))], ["p"], ["weight"])
     return StepFunctions(n, nu, d, m.state_names, [str(s) for s in inputs], pnames, weight, dynamics, contact,
-                         impact, relabel, guard, enabled, distance, normal, rates, input_matrix, f_int)
+                         impact, relabel, guard, enabled, distance, normal, rates, input_matrix, phase_fn,
+                         sp.sstr(phase), f_int)

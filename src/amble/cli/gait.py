@@ -26,14 +26,14 @@ def parse_bounds(items: list[str] | None) -> dict[str, tuple[float | None, float
 
 
 def _guess(text: str | None) -> Any:
-    if text is None or text in ("passive", "stand"):
+    if text is None or text in ("passive", "stand", "interpolate"):
         return text
     if text.startswith("x0="):
         vals = [v for v in text[3:].split(",")]
         if any(not v.strip() for v in vals):
             raise UsageError(f"--guess: empty value in {text!r}")
         return [_float(v, "--guess x0") for v in vals]
-    raise UsageError(f"--guess expects 'passive', 'stand' or 'x0=V1,V2,...', got {text!r}")
+    raise UsageError(f"--guess expects 'passive', 'stand', 'interpolate' or 'x0=V1,V2,...', got {text!r}")
 
 
 def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
@@ -89,9 +89,11 @@ def add_parser(add: Any, model_arg: Any) -> None:
                    help="'effort' (∫|u|² dt per m, default), 'cot' (cost of transport) or an integrand in the "
                         "coordinates, velocities, inputs and parameters, integrated per m")
     o.add_argument("--nodes", type=int, default=30, help="collocation intervals (default 30)")
-    o.add_argument("--guess", help="'passive' (default: a passive step), 'stand' (standing still) or "
-                                   "'x0=V1,V2,...' (a post-impact state walked one step)")
-    o.add_argument("--step-time", type=float, dest="step_time", help="step time of a standing guess in s")
+    o.add_argument("--guess", help="'passive' (default: a passive step), 'stand' (standing still), 'interpolate' "
+                                   "(posture to relabelled posture) or 'x0=V1,V2,...' (a post-impact state "
+                                   "walked one step)")
+    o.add_argument("--step-time", type=float, dest="step_time",
+                   help="step time in s of a 'stand' or 'interpolate' guess (default 0.5)")
     o.add_argument("--mu", type=float, help="friction coefficient at the stance foot (default: no cone)")
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",

@@ -1,7 +1,8 @@
 """The ``amble`` command line: every command is one API call plus input/output.
 
 Exit codes: 0 success, 2 user error (bad model name, parameter, range, path...), 1 internal
-failure or a solver that did not succeed (``SolverError``). Errors are one line on stderr, or ``{"error": ...}`` on stdout with ``--json``.
+failure or a solver that did not succeed (``SolverError``). Errors are one line on stderr, or
+``{"error": ...}`` on stdout with ``--json``.
 """
 
 from __future__ import annotations
