@@ -179,6 +179,8 @@ def _structure_digest(system: HybridSystem) -> str:
         parts += [m._forces, m.gravity_vector]
         parts += [[(a.symbol, a.on) for a in m.actuators], [m._laws.get(a.symbol, 0) for a in m.actuators]]
         parts += [[a.limit for a in m.actuators] if m.saturated else []]
+        vc = m.virtual
+        parts += [[vc.outputs, vc.phase, vc.alpha] if vc is not None else []]
         h.update(dag_srepr(parts).encode())
     for tr in system.transitions:
         h.update(repr((tr.name, tr.source, tr.target, tr.terminal, tr.step)).encode())

@@ -15,11 +15,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
+from typing import Any
 
 import sympy as sp
 
 from ..errors import ModelError
 from ..modelling.model import Model, t
+from .hzd import hzd_law
 from .tree import tree_dynamics
 
 
@@ -83,6 +85,15 @@ class Equations:
     def residual(self) -> sp.Matrix:
         """``M q̈ + h − Γ``: the Euler–Lagrange residual d/dt ∂L/∂q̇ − ∂L/∂q − Γ."""
         return self.M * sp.Matrix(self.qdd) + self.h - self.Gamma
+
+    def expanded(self, expr: Any) -> Any:
+        """``expr`` with the named intermediate quantities of ``compact`` substituted (last first),
+        an expression of the state, time and parameters only."""
+        if self.compact is None:
+            return expr
+        for s, e in reversed(self.compact[0]):
+            expr = expr.xreplace({s: e})
+        return expr
 
     def count_ops(self) -> int:
         """Arithmetic operations needed to evaluate M, h and Γ with common subexpressions shared."""
@@ -223,6 +234,13 @@ def derive(model: Model) -> Equations:
     if model.derived_placeholders and u.rows:
         subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
         u = u.xreplace(subs)
+    if model.virtual is not None:  # the HZD law, as named intermediate quantities after the tree's
+        defs, Mc, hc = compact if compact is not None else ([], M, h)
+        hdefs, u = hzd_law(model, Mc, hc, model.generalized_force, B)
+        if model.saturated:
+            u = sp.Matrix([e if a.limit is None else sp.Max(-a.limit, sp.Min(a.limit, e))
+                           for e, a in zip(u, model.actuators)])
+        compact = ([*defs, *hdefs], Mc, hc)
     return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy,
                      compact=compact, B=B, inputs=model.inputs, u=u)
 

@@ -51,6 +51,8 @@ class Actuators(Names):
         self._saturate = False
         #: placeholder symbol → ("M", i, j) or ("h", i, 0), replaced by derive()
         self.derived_placeholders: dict[sp.Symbol, tuple[str, int, int]] = {}
+        #: virtual constraints of hybrid zero dynamics, if declared (:meth:`virtual_constraints`)
+        self.virtual: Any = None
 
     def _check_new_name(self, name: str, what: str) -> None:
         super()._check_new_name(name, what)
@@ -123,6 +125,21 @@ class Actuators(Names):
         by = {v: k for k, v in self.derived_placeholders.items()}
         return (sp.Matrix(n, n, lambda i, j: by[("M", i, j)]), sp.Matrix(n, 1, lambda i, _: by[("h", i, 0)]))
 
+    def virtual_constraints(self, outputs: Any, phase: Any, alpha: Any, phase_range: tuple[float, float],
+                            epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0) -> Any:
+        """Control the inputs by hybrid zero dynamics: drive ``y = outputs(q) − h_d(phase(q), α)``
+        to zero with ``ÿ = −kd ẏ/ε − kp y/ε²`` (see :mod:`amble.modelling.virtual`). ``alpha``
+        holds one row of Bézier coefficients (rad) per output, ``phase_range`` the phase
+        variable's values ``(θ⁺, θ⁻)`` just after and at a footfall. All become parameters
+        (``alpha_<i>_<k>``, ``phase_start``, ``phase_end``, ``epsilon``, ``kp``, ``kd``).
+        Returns the :class:`~amble.modelling.virtual.VirtualConstraints`."""
+        from .domain import POSITIVE
+        from .virtual import declare
+
+        vc = declare(self, outputs, phase, alpha, phase_range, epsilon, kp, kd)
+        self.declare_domains(epsilon=POSITIVE)
+        return vc
+
     def control(self, laws: Mapping[Any, Any], saturate: bool = False) -> None:
         """Set the closed-loop law ``{input: expression}`` (an input by symbol or name); the
         expressions may use ``q``, ``q̇``, ``t``, parameters and :meth:`dynamics`. Laws given
@@ -130,6 +147,8 @@ class Actuators(Names):
         inputs with a declared limit to ``[−limit, limit]``."""
         if not isinstance(laws, Mapping):
             raise ModelError(f"model {self.name!r}: control() takes a mapping {{input: expression}}, got {laws!r}")
+        if self.virtual is not None:
+            raise ModelError(f"model {self.name!r}: the virtual constraints set the control law already")
         by_name = {str(a.symbol): a.symbol for a in self.actuators}
         allowed = {*self.q, *self.qd, *self.params, *self.derived_placeholders, t}
         for key, law in laws.items():
@@ -170,3 +189,6 @@ class Actuators(Names):
         out.actuators = [Actuator(a.symbol, a.on.subs(subs), a.limit, a.unit) for a in self.actuators]
         out._laws = {k: e.subs(vsubs) for k, e in self._laws.items()}
         out._saturate = self._saturate
+        if self.virtual is not None:
+            raise ModelError(f"model {self.name!r}: virtual constraints cannot be carried into a constrained "
+                             "model; declare them on that model")

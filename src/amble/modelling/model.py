@@ -95,6 +95,18 @@ class Model(Actuators):
         return v.jacobian(self.q) if self.tree is None else sp.Matrix(
             v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j]))
 
+    def point_jacobian(self, name: str) -> sp.Matrix:
+        """``∂p/∂q`` of a named point (dims × n): its velocity is ``J q̇`` (for control laws)."""
+        if name not in self.points:
+            raise ModelError(f"model {self.name!r}: no point named {name!r}")
+        return self.jacobian(self.points[name])
+
+    def point_velocity(self, name: str) -> sp.Matrix:
+        """Velocity (m/s, world axes) of a named point, an expression of q and q̇."""
+        if name not in self.points:
+            raise ModelError(f"model {self.name!r}: no point named {name!r}")
+        return self.dt(self.points[name])
+
     # ------------------------------------------------------------------ geometry
     def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
         """Name a point at ``position`` (2 or 3 components); optionally put a point mass there and

@@ -33,7 +33,10 @@ def _mode_functions(model: Any) -> tuple[Any, Any]:
         args = [_t, *model.q, *model.qd, *model.params]
         u = list(eq.u) if eq.u is not None else []
         w = list(eq.B.T * sp.Matrix(model.qd)) if eq.B is not None and eq.B.cols else []
-        hit = (sp.lambdify(args, u, "numpy", cse=True), sp.lambdify(args, w, "numpy", cse=True))
+        defs = list(eq.compact[0]) if eq.compact is not None else []
+        # the law may be written with named intermediate quantities (HZD): evaluate them in order
+        hit = (sp.lambdify(args, u, "numpy", cse=(lambda e: (defs, e)) if defs else True),
+               sp.lambdify(args, w, "numpy", cse=True))
         _FUNCS[model] = hit
     return hit
 
