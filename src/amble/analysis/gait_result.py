@@ -52,6 +52,9 @@ class Gait:
     constraints: dict[str, dict[str, Any]]
     solver: dict[str, Any]
     bezier: dict[str, Any] | None = None
+    #: the post-impact velocity of the model extended with its base (coordinate rates, then the
+    #: old stance foot's velocity; m/s, rad/s)
+    extended_velocity: np.ndarray | None = None
 
     def state(self, t: Any) -> np.ndarray:
         """The collocation solution at times ``t`` (s, within the step), by its Hermite interpolant."""

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
+from scipy.integrate import solve_ivp
 
 from ..backend.kernels import build
 from ..derivation.equations import derive
@@ -24,7 +25,6 @@ from ..derivation.hzd import zero_dynamics
 from ..errors import ModelError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.simulate import parameter_vector
-from scipy.integrate import solve_ivp
 
 
 @dataclass
