@@ -349,7 +349,8 @@ def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: 
 
 
 class _stdout_to_stderr:
-    """IPOPT prints from C to the process's stdout; progress belongs on stderr (stdout may carry JSON)."""
+    """Solver progress belongs on stderr (stdout may carry JSON). CasADi hands IPOPT's lines to
+    Python's ``sys.stdout``, and C code may print to the process's descriptor 1: both go to stderr."""
 
     def __init__(self, active: bool) -> None:
         self.active = active
@@ -357,11 +358,15 @@ class _stdout_to_stderr:
     def __enter__(self) -> None:
         if self.active:
             sys.stdout.flush()
+            self.saved_py = sys.stdout
+            sys.stdout = sys.stderr
             self.saved = os.dup(1)
             os.dup2(2, 1)
 
     def __exit__(self, *exc: Any) -> None:
         if self.active:
+            sys.stdout.flush()
+            sys.stdout = self.saved_py
             try:
                 import ctypes
 

@@ -36,6 +36,20 @@ def _guess(text: str | None) -> Any:
     raise UsageError(f"--guess expects 'passive', 'stand', 'interpolate' or 'x0=V1,V2,...', got {text!r}")
 
 
+def parse_nodes(text: str) -> list[int]:
+    """``N`` or ``N1,N2,...`` (a mesh refinement) → list of interval counts in [2, 2000]."""
+    out = []
+    for part in text.split(","):
+        try:
+            k = int(part)
+        except ValueError:
+            raise UsageError(f"--nodes expects N or N1,N2,... (integers), got {text!r}") from None
+        if not 2 <= k <= 2000:
+            raise UsageError(f"--nodes: each count must be in [2, 2000], got {k}")
+        out.append(k)
+    return out
+
+
 def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     from ..analysis.gait_optimisation import optimize_gait
 
@@ -46,8 +60,9 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
             raise UsageError(f"--{name.replace('_', '-')} must be positive, got {v:g}")
     if args.clearance is not None and not args.clearance >= 0:
         raise UsageError(f"--clearance must be ≥ 0, got {args.clearance:g}")
-    if not 2 <= args.nodes <= 2000:
-        raise UsageError(f"--nodes must be in [2, 2000], got {args.nodes}")
+    nodes = parse_nodes(args.nodes)
+    if not 1 <= args.bezier_degree <= 20:
+        raise UsageError(f"--bezier-degree must be in [1, 20], got {args.bezier_degree}")
     if args.max_iter < 1:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
     bounds = parse_bounds(args.bound)
@@ -55,8 +70,9 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     s = load_model(args.model)
     params = parse_sets(args.set)
     gait = optimize_gait(s, params=params, speed=args.speed, step_length=args.step_length, objective=args.objective,
-                         nodes=args.nodes, guess=guess, step_time=args.step_time, mu=args.mu,
-                         clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, progress=not args.quiet)
+                         nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time, mu=args.mu,
+                         clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, hzd=args.hzd,
+                         bezier_degree=args.bezier_degree, progress=not args.quiet)
     out = gait.to_json()
     if out_p:
         gait.save(out_p)
@@ -88,7 +104,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--objective", default="effort",
                    help="'effort' (∫|u|² dt per m, default), 'cot' (cost of transport) or an integrand in the "
                         "coordinates, velocities, inputs and parameters, integrated per m")
-    o.add_argument("--nodes", type=int, default=30, help="collocation intervals (default 30)")
+    o.add_argument("--nodes", default="30",
+                   help="collocation intervals (default 30), or N1,N2,... to refine the mesh (e.g. 20,60)")
     o.add_argument("--guess", help="'passive' (default: a passive step), 'stand' (standing still), 'interpolate' "
                                    "(posture to relabelled posture) or 'x0=V1,V2,...' (a post-impact state "
                                    "walked one step)")
@@ -98,6 +115,11 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",
                    help="limits of a coordinate or velocity over the step (repeatable; a side may be empty)")
+    o.add_argument("--hzd", action="store_true",
+                   help="make the gait satisfy Bézier virtual constraints (their α are optimised too), so "
+                        "that an HZD controller with the exported α reproduces it")
+    o.add_argument("--bezier-degree", type=int, default=5, dest="bezier_degree",
+                   help="degree of the Bézier virtual constraints (default 5)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")
