@@ -51,3 +51,12 @@ def test_compass_gait_dynamics_and_exact_derivatives(compass):
                            - np.asarray(fns.dynamics(q - e, qd, a, np.zeros(0), 0.0, p))).ravel() / 2e-6
                           for e in np.eye(2) * 1e-6])
     assert np.allclose(np.asarray(jac(q)), fd, rtol=1e-6, atol=1e-6)
+
+
+def test_import_amble_does_not_import_casadi():
+    import subprocess
+    import sys
+
+    code = "import amble, amble.cli.main, amble.analysis.poincare, sys; print('casadi' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "False", out.stderr
