@@ -13,7 +13,9 @@ full-order multipliers as ``ε → 0``.
 from __future__ import annotations
 
 from collections.abc import Mapping
+import weakref
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -55,32 +57,68 @@ def _controlled_mode(system: HybridSystem):
     return mode, model, step
 
 
+@dataclass
+class _Functions:
+    """NumPy functions of one model's zero dynamics and outputs (arguments: the named state or
+    phase values, then the parameters in the model's order)."""
+
+    Phi: Any
+    dPhi: Any
+    a: Any  # θ̈ at θ̇ = 0
+    a1: Any  # θ̈ at θ̇ = 1
+    y: Any
+    y_dot: Any
+    phase_rate: Any
+    h0: Any
+    h0_rate: Any
+    phase: Any
+
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _functions(model: Any) -> _Functions:
+    hit = _CACHE.get(model)
+    if hit is not None:
+        return hit
+    eq = derive(model)
+    zd = zero_dynamics(model, eq.M, eq.h, eq.Gamma, eq.B)
+    vc = model.virtual
+    ps, q, qd = list(model.params), list(model.q), sp.Matrix(model.qd)
+    th, thd = zd.theta, zd.theta_dot
+    lam = lambda args, e: sp.lambdify([*args, *ps], e, "numpy", cse=True)
+    acc = zd.theta_ddot
+    H = model.jacobian(vc.y)
+    dh0 = vc.outputs.jacobian(q)
+    dth = sp.Matrix([vc.phase]).jacobian(q)
+    x = [*q, *model.qd]
+    hit = _Functions(
+        Phi=lam([th], list(zd.Phi)), dPhi=lam([th], list(zd.dPhi)),
+        a=lam([th], acc.xreplace({thd: 0})), a1=lam([th], acc.xreplace({thd: 1})),
+        y=lam(x, list(vc.y)), y_dot=lam(x, list(H * qd)), phase_rate=lam(x, (dth * qd)[0]),
+        h0=lam(x, list(vc.outputs)), h0_rate=lam(x, list(dh0 * qd)), phase=lam(x, vc.phase))
+    _CACHE[model] = hit
+    return hit
+
+
 def impact_on_zero_dynamics(system: HybridSystem, params: Mapping[str, float] | None = None) -> ImpactOnZ:
     """The footfall from ``Z ∩ S`` (see the module), at these parameters."""
     mode, model, step = _controlled_mode(system)
     k = build(system)
     p = parameter_vector(k, params, system)
     pv = dict(zip(k.meta["params"], p.tolist()))
-    eq = derive(model)
-    zd = zero_dynamics(model, eq.M, eq.h, eq.Gamma, eq.B)
-    vc = model.virtual
-    psubs = {s: pv[str(s)] for s in model.params}
-    th_end = pv[str(vc.phase_end)]
-    q_pre = np.array([float(e) for e in zd.Phi.subs(psubs).subs(zd.theta, th_end)])
-    v_pre = np.array([float(e) for e in zd.dPhi.subs(psubs).subs(zd.theta, th_end)])
-    x_pre = np.concatenate([q_pre, v_pre])
-    g = float(k.guards(mode, 0.0, x_pre, p)[[tr.name for tr in system.transitions if tr.source == mode].index(step.name)])
+    fn = _functions(model)
+    pm = [pv[str(s)] for s in model.params]
+    th_end = pv[str(model.virtual.phase_end)]
+    x_pre = np.concatenate([np.asarray(fn.Phi(th_end, *pm), float), np.asarray(fn.dPhi(th_end, *pm), float)])
+    names = [tr.name for tr in system.transitions if tr.source == mode]
+    g = float(k.guards(mode, 0.0, x_pre, p)[names.index(step.name)])
     _, x_post = k.reset(step.name, 0.0, x_pre, p)
-    dst = system.modes[step.target]
-    if dst is not model:
+    if system.modes[step.target] is not model:
         raise ModelError(f"system {system.name!r}: the footfall must return to the controlled mode")
-    n = len(model.q)
-    state = {**dict(zip(model.q, x_post[:n])), **dict(zip(model.qd, x_post[n:])), **psubs}
-    H = model.jacobian(vc.y)
-    y = np.array([float(e) for e in vc.y.subs(state)])
-    yd = np.array([float(e) for e in (H * sp.Matrix(model.qd)).subs(state)])
-    dth = float(sp.Matrix([vc.phase]).jacobian(model.q).dot(sp.Matrix(model.qd)).subs(state))
-    return ImpactOnZ(x_post, dth, y, yd, g)
+    args = [*x_post, *pm]
+    return ImpactOnZ(np.asarray(x_post, float), float(fn.phase_rate(*args)), np.asarray(fn.y(*args), float),
+                     np.asarray(fn.y_dot(*args), float), g)
 
 
 def hybrid_invariance_error(system: HybridSystem, params: Mapping[str, float] | None = None) -> float:
@@ -100,17 +138,15 @@ def invariant_parameters(system: HybridSystem, params: Mapping[str, float] | Non
     out = dict(system.parameters)
     out.update(params or {})
     imp = impact_on_zero_dynamics(system, out)
-    n = len(model.q)
-    state = {**dict(zip(model.q, imp.x_post[:n])), **dict(zip(model.qd, imp.x_post[n:]))}
-    state.update({s: out[str(s)] for s in model.params})
-    h0 = [float(e) for e in vc.outputs.subs(state)]
-    dh0 = [float(e) for e in (vc.outputs.jacobian(model.q) * sp.Matrix(model.qd)).subs(state)]
-    th_plus = float(vc.phase.subs(state))
+    fn = _functions(model)
+    args = [*imp.x_post, *[out[str(s)] for s in model.params]]
+    h0, dh0 = np.asarray(fn.h0(*args), float), np.asarray(fn.h0_rate(*args), float)
+    th_plus = float(fn.phase(*args))
     th_end = out[str(vc.phase_end)]
     out[str(vc.phase_start)] = th_plus
     for i in range(vc.alpha.rows):
-        out[str(vc.alpha[i, 0])] = h0[i]
-        out[str(vc.alpha[i, 1])] = h0[i] + (th_end - th_plus) / vc.degree * dh0[i] / imp.delta
+        out[str(vc.alpha[i, 0])] = float(h0[i])
+        out[str(vc.alpha[i, 1])] = float(h0[i] + (th_end - th_plus) / vc.degree * dh0[i] / imp.delta)
     return out
 
 
@@ -135,14 +171,12 @@ def restricted_map(system: HybridSystem, params: Mapping[str, float] | None = No
     _, model, _ = _controlled_mode(system)
     pv = dict(system.parameters)
     pv.update(params or {})
-    eq = derive(model)
-    if any(e != 0 for e in eq.Gamma):
+    if any(e != 0 for e in model.generalized_force):
         raise ModelError(f"model {model.name!r}: the restricted map needs Γ = 0 besides the inputs")
-    zd = zero_dynamics(model, eq.M, eq.h, eq.Gamma, eq.B)
-    psubs = {s: pv[str(s)] for s in model.params}
-    acc = zd.theta_ddot.xreplace(psubs)
-    a = sp.lambdify(zd.theta, acc.xreplace({zd.theta_dot: 0}), "math", cse=True)
-    a1 = sp.lambdify(zd.theta, acc.xreplace({zd.theta_dot: 1}), "math", cse=True)
+    fn = _functions(model)
+    pm = [pv[str(s)] for s in model.params]
+    a = lambda th: float(fn.a(th, *pm))
+    a1 = lambda th: float(fn.a1(th, *pm))
     vc = model.virtual
     th0, th1 = pv[str(vc.phase_start)], pv[str(vc.phase_end)]
 

@@ -129,6 +129,11 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     guess = _start(s, args.guess, params) if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
     out = lc.to_json()
+    if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
+        from ..analysis.gait_check import check_gait
+
+        # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
+        out["checks"] = check_gait(lc.trajectory()).to_json()
     if plot_p or anim_p:
         from ..simulation.simulate import simulate
 
@@ -149,6 +154,9 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
               f"step time {lc.step_time:.6g} s (residual {lc.residual:.1e}, {lc.iterations} iterations)")
         print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
         print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
+        if "checks" in out:
+            failed = [k for k, v in out["checks"].items() if v is False]
+            print("gait checks: " + ("all passed" if not failed else "FAILED " + ", ".join(failed)))
         for k in ("plot", "animation"):
             if k in out:
                 print(f"wrote {out[k]}")
