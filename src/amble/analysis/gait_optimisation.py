@@ -127,7 +127,7 @@ def optimize_gait(
     warm: Gait | None = None
     total_iter, total_time = 0, 0.0
 
-    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None) -> Gait:
+    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None, hzd: bool) -> Gait:
         # ------------------------------------------------------------------ unknowns
         # MX with each model function mapped over the points: the graph holds one copy of each
         # function, not 2N + 1 inlined ones (building the problem is then independent of N)
@@ -228,7 +228,7 @@ def optimize_gait(
             worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
             reason = _FAILURES.get(status, status.replace("_", " ").lower())
             binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"
-                       if worst[1]["max_violation"] > tol
+                       if worst[1]["max_violation"] > tol else "at the starting point" if not stats.get("iter_count")
                        else "every constraint holds at the last iterate (the optimality conditions do not)")
             raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
                               f"{binding}")
@@ -236,11 +236,17 @@ def optimize_gait(
                      {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed,
                       "nodes": N}, bezier_degree)
 
-    for N in levels:
+    theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
+    presolve = hzd and not theta[1] - theta[0] > 1e-9
+    if presolve:
+        # the start does not move (standing): no phase to write virtual constraints in; a first
+        # solve without them finds a step, and the virtual constraints start from it
+        levels = [levels[0], *levels]
+    for i, N in enumerate(levels):
         if warm is not None:  # a finer mesh starts from the coarser solution, interpolated
             tau = np.linspace(0.0, warm.step_time, 2 * N + 1)
             x_guess, t_guess = warm.state(tau), warm.step_time
-        warm = solve(N, x_guess, t_guess, warm)
+        warm = solve(N, x_guess, t_guess, warm, hzd and not (presolve and i == 0))
         total_iter += warm.solver["iterations"]
         total_time += warm.solver["time_s"]
     assert warm is not None
