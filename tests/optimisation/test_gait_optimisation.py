@@ -60,6 +60,21 @@ def test_passive_simulation_reproduces_the_collocated_step(passive_optimum):
     assert lc.residual <= 1e-8 and np.abs(lc.fixed_point - g.fixed_point).max() <= 1e-6
 
 
+def test_contact_force_matches_the_gait_check_of_the_simulated_step(passive_optimum):
+    """The stance-foot force the NLP constrains against the ground reaction that
+    amble.analysis.gait_check computes from the simulated step (its own NumPy code, the
+    accelerations from the compiled right-hand side)."""
+    from amble.analysis.gait_check import ground_reaction
+
+    _, g = passive_optimum
+    tr = simulate(load("compass-gait"), g.fixed_point, params={"slope": SLOPE}, steps=1, sample_dt=0.01)
+    F, _, _ = ground_reaction(tr)
+    inside = tr.t < min(tr.step_events[0].t, g.step_time)
+    ours = np.column_stack([np.interp(tr.t[inside], g.times, g.contact_forces[:, i]) for i in range(2)])
+    assert np.abs(ours - F[inside][:, [0, 2]]).max() <= 1e-2 * np.abs(F[inside]).max()
+    assert g.contact_forces[:, 1].min() > 0  # the ground pushes up throughout the step
+
+
 def _momenta(x, l, a, b, m, mh):
     """Closed-form compass gait (Drake's angles): total angular momentum about the swing foot, and
     each leg's about the hip (absolute velocities), in the frame of the stance foot."""

@@ -346,11 +346,12 @@ def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: 
     qe, impulse = w[base: base + n + fns.dims], w[base + n + fns.dims: base + n + 2 * fns.dims]
     P = np.array([pvals[k] for k in fns.param_names])
     L = float(fns.distance(X[-1, :n], P))
+    forces = np.array([np.asarray(fns.contact(x[:n], x[n:], a, P), float).ravel() for x, a in zip(X, A)])
     return Gait(system=system.name, state_names=list(fns.state_names), input_names=list(fns.input_names),
                 params=pvals, objective_name=str(objective), objective=value, fixed_point=X[0].copy(),
                 step_time=T, step_length=L, speed=L / T, times=np.linspace(0.0, T, K), states=X,
                 accelerations=A, inputs=U, pre_impact_state=X[-1].copy(), impulse=np.asarray(impulse),
-                extended_velocity=np.asarray(qe),
+                extended_velocity=np.asarray(qe), contact_forces=forces,
                 constraints=report, solver=solver, bezier=bezier_fit(model, fns, X, degree, P))
 
 

@@ -55,6 +55,9 @@ class Gait:
     #: the post-impact velocity of the model extended with its base (coordinate rates, then the
     #: old stance foot's velocity; m/s, rad/s)
     extended_velocity: np.ndarray | None = None
+    #: the ground's force on the stance foot at the collocation points (N, world axes of the
+    #: step's frame: ``(x, z)`` in 2D, ``(x, y, z)`` in 3D)
+    contact_forces: np.ndarray | None = None
 
     def state(self, t: Any) -> np.ndarray:
         """The collocation solution at times ``t`` (s, within the step), by its Hermite interpolant."""
@@ -88,7 +91,8 @@ class Gait:
             "step_length": self.step_length, "speed": self.speed,
             "pre_impact_state": self.pre_impact_state.tolist(), "impulse": self.impulse.tolist(),
             "trajectory": {"t": self.times.tolist(), "states": self.states.tolist(),
-                           "accelerations": self.accelerations.tolist(), "inputs": self.inputs.tolist()},
+                           "accelerations": self.accelerations.tolist(), "inputs": self.inputs.tolist(),
+                           "contact_force": None if self.contact_forces is None else self.contact_forces.tolist()},
             "constraints": self.constraints, "max_violation": self.max_violation,
             "bezier": self.bezier, "solver": self.solver,
         }
