@@ -12,7 +12,7 @@ import numpy as np
 import sympy as sp
 
 from ..backend.casadi_export import StepFunctions
-from ..errors import OutputError
+from ..errors import ModelError, OutputError
 from .collocation import hermite
 
 #: an inequality whose slack is below this (in its own unit) is reported as active (binding)
@@ -76,6 +76,30 @@ class Gait:
         a, m, b = self.inputs[2 * i], self.inputs[2 * i + 1], self.inputs[2 * i + 2]
         return ((2 * (s - 0.5) * (s - 1))[:, None] * a + (-4 * s * (s - 1))[:, None] * m
                 + (2 * s * (s - 0.5))[:, None] * b)
+
+    def input_laws(self, model: Any) -> dict[sp.Symbol, sp.Expr]:
+        """The optimised inputs as open-loop laws of time for ``model.control(...)``: on each
+        interval the quadratic through its three collocation points (``Piecewise`` in ``t``,
+        seconds since the start of the step), the last piece held beyond the step."""
+        from ..modelling.geometry import t as time
+
+        N = (len(self.times) - 1) // 2
+        h = self.step_time / N
+        by_name = {str(u): u for u in getattr(model, "inputs", [])}
+        missing = [k for k in self.input_names if k not in by_name]
+        if missing:
+            raise ModelError(f"model {model.name!r} has no input(s) {', '.join(missing)} of this gait")
+        laws = {}
+        for j, name in enumerate(self.input_names):
+            pieces = []
+            for i in range(N):
+                a, m, b = (float(v) for v in self.inputs[2 * i: 2 * i + 3, j])
+                s = (time - i * h) / h
+                half = sp.Rational(1, 2)
+                expr = 2 * a * (s - half) * (s - 1) - 4 * m * s * (s - 1) + 2 * b * s * (s - half)
+                pieces.append((expr, time < (i + 1) * h) if i < N - 1 else (expr, True))
+            laws[by_name[name]] = sp.Piecewise(*pieces)
+        return laws
 
     @property
     def max_violation(self) -> float:
