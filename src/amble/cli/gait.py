@@ -79,9 +79,9 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
         out["out"] = str(out_p)
     if not args.json:
         sv = gait.solver
+        its, secs = sv.get("iterations_total", sv["iterations"]), sv.get("time_total_s", sv["time_s"])
         print(f"{args.model}: objective {gait.objective_name} {gait.objective:.6g}, step time {gait.step_time:.6g} s, "
-              f"step length {gait.step_length:.6g} m, speed {gait.speed:.6g} m/s "
-              f"({sv.get('iterations_total', sv['iterations'])} iterations, {sv.get('time_total_s', sv['time_s']):.2f} s "
+              f"step length {gait.step_length:.6g} m, speed {gait.speed:.6g} m/s ({its} iterations, {secs:.2f} s "
               f"in the solver, max violation {gait.max_violation:.1e})")
         print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(gait.state_names, gait.fixed_point)))
         active = [k for k, r in gait.constraints.items() if r["active"]]
