@@ -1,5 +1,6 @@
-"""RABBIT: the five-link planar biped of Chevallereau et al. (2003) on level ground, point feet,
-four actuated joints (hips, knees), under hybrid zero dynamics (Westervelt et al. 2007).
+"""RABBIT: the five-link planar biped (Chevallereau et al. 2003) on level ground, under HZD.
+
+Point feet, four actuated joints (hips, knees), hybrid zero dynamics (Westervelt et al. 2007).
 
 Links: a torso and two legs of femur and tibia. Parameters as given in the issue after
 Chevallereau et al. 2003 / Westervelt et al. 2007, Table 6.3: torso ``mT`` 20 kg, length 0.625 m,
