@@ -10,7 +10,6 @@ from scipy.integrate import solve_ivp
 from amble import Model, ModelError, R, derive, simulate, walker
 from amble.analysis.hzd import hybrid_invariance_error, impact_on_zero_dynamics, invariant_parameters, restricted_map
 from amble.analysis.poincare import find_fixed_point
-from amble.backend.kernels import build
 from amble.derivation.hzd import zero_dynamics
 
 

@@ -30,7 +30,7 @@ def test_held_law_matches_an_interval_by_interval_integration():
     y, t = np.array([0.4, 0.0]), 0.0
     for _ in range(int(rate)):  # one sample, then the held torque for 1/rate s
         u = law(y)
-        sol = solve_ivp(lambda _t, z: [z[1], (u + 9.81 * 0.5 * np.sin(z[0])) / 0.25], (t, t + 1 / rate), y,
+        sol = solve_ivp(lambda _t, z, u=u: [z[1], (u + 9.81 * 0.5 * np.sin(z[0])) / 0.25], (t, t + 1 / rate), y,
                         rtol=1e-12, atol=1e-12)
         y, t = sol.y[:, -1], t + 1 / rate
     assert tr.final_state[0] == pytest.approx(y[0], abs=1e-8)

@@ -12,13 +12,14 @@ full-order multipliers as ``ε → 0``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import sympy as sp
+from scipy.integrate import solve_ivp
 
 from ..backend.kernels import build
 from ..derivation.equations import derive
@@ -26,7 +27,6 @@ from ..derivation.hzd import zero_dynamics
 from ..errors import ModelError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.simulate import parameter_vector
-from scipy.integrate import solve_ivp
 
 
 @dataclass

@@ -28,8 +28,8 @@ import math
 import sympy as sp
 
 from ..errors import ModelError
-from .hybrid import Explicit, Guard, HybridSystem, Impact, Lock, Transition
 from .geometry import t
+from .hybrid import Explicit, Guard, HybridSystem, Impact, Lock, Transition
 from .model import Model
 
 
@@ -90,7 +90,8 @@ def sample_and_hold(system: HybridSystem, rate: float) -> HybridSystem:
                 **{str(h): law[j] for j, h in enumerate(held)}}
         vmap = {**{str(v): v for v in m.qd[:n0]}, str(m.dot(clock)): sp.Integer(1),
                 **{str(m.dot(h)): sp.Integer(0) for h in held}}
-        out.transition("sample" if len(modes) == 1 else f"sample_{name}", name, Guard(clock - 1 / rate, +1), Explicit(qmap, vmap), name)
+        label = "sample" if len(modes) == 1 else f"sample_{name}"
+        out.transition(label, name, Guard(clock - 1 / rate, +1), Explicit(qmap, vmap), name)
         start = system.default_start.get(name)
         if start is not None:
             subs = {**dict(zip([*m.q[:n0], *m.qd[:n0]], start)), **m.params}

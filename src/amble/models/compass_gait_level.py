@@ -24,7 +24,7 @@ import sympy as sp
 from amble import POSITIVE, Model, R, walker
 
 NAME = "compass-gait-level"
-POSITION = 11  # after compass-gait
+POSITION = 45  # after the thesis models
 
 
 def build():

@@ -74,7 +74,8 @@ def build() -> Walker:
     tau_leg = sp.Piecewise((-k_leg * step, step > 0), (0, True))
     dot = m.dot
     m.force([0, tau_leg, -k_sc * st_c - kv_sc * dot(st_c), -k_sw * sw_c - kv_sw * dot(sw_c),
-             k_t * (th_d - (tor + gamma)) - kv_t * dot(tor), -k_tc * tor_c - kv_tc * dot(tor_c), -k_y * yaw - kv_y * dot(yaw)])
+             k_t * (th_d - (tor + gamma)) - kv_t * dot(tor), -k_tc * tor_c - kv_tc * dot(tor_c),
+             -k_y * yaw - kv_y * dot(yaw)])
     # controlled symmetry: inputs on every coordinate (ankle pitch and roll of the stance foot,
     # hip pitch and roll of the swing leg, waist pitch, roll and yaw) replace the potential by
     # the one of the robot turned by γ about the lateral axis

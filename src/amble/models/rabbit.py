@@ -33,7 +33,7 @@ the zero dynamics and is stable. ``epsilon`` 0.1 s, ``kp`` 1, ``kd`` 2.
 from amble import POSITIVE, Model, R, walker
 
 NAME = "rabbit"
-POSITION = 40
+POSITION = 46  # after compass-gait-level
 
 #: Bézier coefficients (rad), rows: stance hip, swing hip, stance knee, swing knee. The last
 #: column is the pose at the footfall (step length 0.395 m); the interior ones were fitted for a
