@@ -43,7 +43,8 @@ def _extend(m: Model) -> tuple[Model, sp.Symbol, list[sp.Symbol]]:
     out._k_terms, out._k_added = list(m._k_terms), list(m._k_added)
     (clock,) = out.coordinates("clock", unit=m.time_unit)
     held = [out.coordinates(f"held_{a.symbol}", unit=a.unit)[0] for a in m.actuators]
-    out.add_kinetic(sum((v**2 for v in out.qd[len(m.q):]), sp.Integer(0)) / 2)
+    for c in (clock, *held):  # ½ ċ²: a unit "inertia" that the impact of a footfall leaves alone
+        out.inertia(c, 1)
     extra = sp.zeros(len(held) + 1, 1)
     out._forces = [f.col_join(extra) for f in m._forces]
     law = m.control_law  # saturated as declared
