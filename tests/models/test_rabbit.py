@@ -42,10 +42,26 @@ def _restricted_scipy(system):
     return w, (P(w + h)[0] - P(w - h)[0]) / (2 * h), P(w)[1]
 
 
-def test_multipliers_converge_to_the_restricted_map(rabbit):
+@pytest.fixture(scope="module")
+def restricted(rabbit):
+    return _restricted_scipy(rabbit)
+
+
+def test_the_gait_multiplier_is_the_restricted_one(rabbit, restricted):
+    """At the default ε = 0.1: the orbit lies on Z, so one multiplier is the restricted map's."""
     assert hybrid_invariance_error(rabbit) < 1e-9
-    w, lam, T = _restricted_scipy(rabbit)
+    w, lam, T = restricted
     assert 0 < lam < 1
+    lc = find_fixed_point(rabbit)
+    mods = np.sort(np.abs(lc.multipliers))[::-1]
+    assert mods[0] == pytest.approx(lam, abs=1e-6) and mods[1] < 0.1
+    assert lc.step_time == pytest.approx(T, abs=1e-6)
+    x = lc.fixed_point  # θ̇⁺ = torso_dot + stance_hip_dot + stance_knee_dot/2 is the restricted fixed point
+    assert x[5] + x[6] + x[8] / 2 == pytest.approx(w, abs=1e-7)
+
+
+def test_multipliers_converge_to_the_restricted_map(rabbit, restricted):
+    w, lam, T = restricted
     second = []
     for eps in (0.2, 0.1, 0.05, 0.025):
         lc = find_fixed_point(rabbit, params={"epsilon": eps})
