@@ -54,3 +54,4 @@ def test_limit_cycle_json_reports_the_checks_of_an_actuated_model(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["stable"] and out["checks"]["normal_force_positive"] and out["checks"]["mu"] == 0.7
     assert out["checks"]["max_friction_ratio"] > 0
+    assert set(out["work_per_step"]) == {"hip", "ankle"} and out["cost_of_transport"] > 0

@@ -38,13 +38,15 @@ def test_computed_torque_is_one_line_and_makes_the_error_linear():
 def test_point_jacobian_and_velocity():
     m, (a, b), _ = _double_pendulum()
     J = m.point_jacobian("tip")
-    assert sp.simplify(J - sp.Matrix([[0.6 * sp.cos(a), 0.4 * sp.cos(b)], [-0.6 * sp.sin(a), -0.4 * sp.sin(b)]])) == sp.zeros(2, 2)
+    exact = sp.Matrix([[0.6 * sp.cos(a), 0.4 * sp.cos(b)], [-0.6 * sp.sin(a), -0.4 * sp.sin(b)]])
+    assert sp.simplify(J - exact) == sp.zeros(2, 2)
     assert sp.simplify(m.point_velocity("tip") - J * sp.Matrix(m.qd)) == sp.zeros(2, 1)
 
 
 def test_saturation_clips_at_the_declared_limit():
     """An inverted pendulum pushed with 50 N·m through a 3 N·m actuator follows
-    m l² θ̈ = 3 + m g l sin θ (SciPy; R(θ) points up, an inverted pendulum), and the recorded input is the clipped one."""
+    m l² θ̈ = 3 + m g l sin θ (SciPy; R(θ) points up, an inverted pendulum), and the recorded
+    input is the clipped one."""
     m = Model("pushed")
     (th,) = m.coordinates("theta")
     m.point("pivot", (0, 0))

@@ -1,7 +1,8 @@
 """Controlled symmetry: the level-ground compass gait reproduces the passive slope gait turned
 by the slope — fixed point and step time to 1e-10, the return maps conjugate by the turn to
-1e-10 (so their multipliers are the same), and the multipliers of find_fixed_point (central
-differences of step 1e-5, good to ~1e-9) to 1e-8."""
+1e-10, the multipliers of both maps' Jacobians (central differences with Richardson
+extrapolation, h = 1e-3, whose round-off is ~1e-12) to 1e-10, and those find_fixed_point reports
+(central differences of step 1e-5, round-off ~1e-9) to 1e-8."""
 
 import numpy as np
 import pytest
@@ -33,6 +34,15 @@ def test_level_gait_is_the_passive_slope_gait_turned(gamma):
         xl, tl = Pl(x - shift)
         np.testing.assert_allclose(xl, xp - shift, rtol=0, atol=1e-10)
         assert tl == pytest.approx(tp, abs=1e-10)
+
+    def jacobian(P, x, h=1e-3):  # Richardson-extrapolated central differences, error O(h⁴)
+        d = lambda h: np.column_stack([(P(x + h * e)[0] - P(x - h * e)[0]) / (2 * h) for e in np.eye(4)])
+        return (4 * d(h / 2) - d(h)) / 3
+
+    mp = np.sort_complex(np.linalg.eigvals(jacobian(Pp, passive.fixed_point)))
+    ml = np.sort_complex(np.linalg.eigvals(jacobian(Pl, level.fixed_point)))
+    np.testing.assert_allclose(ml, mp, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(np.sort(np.abs(mp))[1:], np.sort(np.abs(passive.multipliers)), atol=1e-6)
 
 
 def test_the_controller_works_against_gravity_only():

@@ -107,7 +107,8 @@ def ground_reaction(traj: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         model = system.modes[mname]
         acc, _, mass = _momentum_functions(model)
         pm = [traj.parameters[str(s)] for s in model.params]
-        gvec = np.array([float(e.subs({s: traj.parameters[str(s)] for s in model.params})) for e in model.gravity_vector])
+        gsubs = {s: traj.parameters[str(s)] for s in model.params}
+        gvec = np.array([float(e.subs(gsubs)) for e in model.gravity_vector])
         n = len(model.q)
         for r in rows:
             x = traj.x[r, : 2 * n]

@@ -77,7 +77,9 @@ class _Functions:
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _functions(model: Any) -> _Functions:
+def zero_dynamics_functions(model: Any) -> _Functions:
+    """NumPy functions of a model's zero dynamics (Φ, Φ', θ̈ at θ̇ = 0 and 1) and of its outputs,
+    phase and their rates (cached per model; arguments: the values, then the parameters)."""
     hit = _CACHE.get(model)
     if hit is not None:
         return hit
@@ -107,7 +109,7 @@ def impact_on_zero_dynamics(system: HybridSystem, params: Mapping[str, float] | 
     k = build(system)
     p = parameter_vector(k, params, system)
     pv = dict(zip(k.meta["params"], p.tolist()))
-    fn = _functions(model)
+    fn = zero_dynamics_functions(model)
     pm = [pv[str(s)] for s in model.params]
     th_end = pv[str(model.virtual.phase_end)]
     x_pre = np.concatenate([np.asarray(fn.Phi(th_end, *pm), float), np.asarray(fn.dPhi(th_end, *pm), float)])
@@ -138,7 +140,7 @@ def invariant_parameters(system: HybridSystem, params: Mapping[str, float] | Non
     out = dict(system.parameters)
     out.update(params or {})
     imp = impact_on_zero_dynamics(system, out)
-    fn = _functions(model)
+    fn = zero_dynamics_functions(model)
     args = [*imp.x_post, *[out[str(s)] for s in model.params]]
     h0, dh0 = np.asarray(fn.h0(*args), float), np.asarray(fn.h0_rate(*args), float)
     th_plus = float(fn.phase(*args))
@@ -173,7 +175,7 @@ def restricted_map(system: HybridSystem, params: Mapping[str, float] | None = No
     pv.update(params or {})
     if any(e != 0 for e in model.generalized_force):
         raise ModelError(f"model {model.name!r}: the restricted map needs Γ = 0 besides the inputs")
-    fn = _functions(model)
+    fn = zero_dynamics_functions(model)
     pm = [pv[str(s)] for s in model.params]
     a = lambda th: float(fn.a(th, *pm))
     a1 = lambda th: float(fn.a1(th, *pm))

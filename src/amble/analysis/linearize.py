@@ -67,5 +67,6 @@ def linearize(system: HybridSystem, x: Sequence[float], u: Sequence[float] | Non
     A_q = np.linalg.solve(M, rq - np.einsum("ijk,j->ik", dMq, qdd))
     A_v = np.linalg.solve(M, rv)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [A_q, A_v]])
-    Bx = np.vstack([np.zeros((n, nu)), np.linalg.solve(M, np.asarray(B, float).reshape(n, nu))]) if nu else np.zeros((2 * n, 0))
+    Bu = np.linalg.solve(M, np.asarray(B, float).reshape(n, nu)) if nu else np.zeros((n, 0))
+    Bx = np.vstack([np.zeros((n, nu)), Bu])
     return A, Bx

@@ -67,7 +67,7 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
         col = "v"
     nv = max(len(inputs), 1)
     low = [(i, j) for i in range(n) for j in range(i + 1)]
-    exprs = [M[i, j] for i, j in low] + [eq.Gamma[i] - h[i] for i in range(n)]
+    exprs = [M[i, j] for i, j in low] + [eq.closed_loop_force[i] - h[i] for i in range(n)]
     vt = [f"M[{i * n + j}]" for i, j in low] + [f"f[{i}]" for i in range(n)]
     rows = [i * n + j for i, j in low] + [None] * n
 

@@ -84,6 +84,12 @@ def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
             "gravity_vector": [sp.sstr(e) for e in m.gravity_vector],
             "operation_count": eq.count_ops(),
         }
+        if eq.inputs:  # an actuated mode: the inputs, B, and how each is controlled
+            entry["inputs"] = [str(u) for u in eq.inputs]
+            entry["input_matrix"] = _rows(eq.B)
+            entry["input_limits"] = m.input_limits
+            entry["control"] = ("hybrid zero dynamics" if m.virtual is not None else
+                                [_text(e) for e in m.control_law])
         if args.latex:
             entry["latex"] = eq.latex()
         out["modes"][mname] = entry
@@ -118,6 +124,9 @@ def _print(out: dict[str, Any], latex: bool) -> None:
             if any(g != "0" for g in e["generalized_force"]):
                 for i, g in enumerate(e["generalized_force"]):
                     print(f"  Gamma[{i}] = {g}")
+            if "inputs" in e:
+                print(f"  inputs u = ({', '.join(e['inputs'])}), B = {e['input_matrix']}")
+                print(f"  control: {e['control']}")
         print(f"  operations (shared subexpressions): {e['operation_count']}")
     for tr in out["transitions"]:
         g = tr["guard_detail"]

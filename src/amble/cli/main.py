@@ -133,7 +133,10 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         from ..analysis.gait_check import check_gait
 
         # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
-        out["checks"] = check_gait(lc.trajectory()).to_json()
+        gait = lc.trajectory(steps=lc.period)
+        out["checks"] = check_gait(gait).to_json()
+        out["work_per_step"] = {k: float(v.sum()) for k, v in gait.work_per_step().items()}  # J per period
+        out["cost_of_transport"] = gait.cost_of_transport()
     if plot_p or anim_p:
         from ..simulation.simulate import simulate
 

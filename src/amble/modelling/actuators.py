@@ -78,9 +78,11 @@ class Actuators(Names):
             try:
                 limit = float(limit)
             except (TypeError, ValueError):
-                raise ModelError(f"model {self.name!r}: limit of input {name!r} must be a number, got {limit!r}") from None
+                raise ModelError(f"model {self.name!r}: limit of input {name!r} must be a number, "
+                                 f"got {limit!r}") from None
             if not limit > 0 or limit == float("inf"):
-                raise ModelError(f"model {self.name!r}: limit of input {name!r} must be positive and finite, got {limit}")
+                raise ModelError(f"model {self.name!r}: limit of input {name!r} must be positive and finite, "
+                                 f"got {limit}")
         if unit is None:
             unit = "N·m" if all(self.units.get(str(s), "rad") == "rad" for s in coords) else "N"
         sym = sp.Symbol(name, real=True)

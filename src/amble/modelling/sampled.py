@@ -43,7 +43,8 @@ def _extend(m: Model) -> tuple[Model, sp.Symbol, list[sp.Symbol]]:
     out._k_terms, out._k_added = list(m._k_terms), list(m._k_added)
     (clock,) = out.coordinates("clock", unit=m.time_unit)
     held = [out.coordinates(f"held_{a.symbol}", unit=a.unit)[0] for a in m.actuators]
-    out.add_kinetic(sum((v**2 for v in out.qd[len(m.q):]), sp.Integer(0)) / 2)
+    for c in (clock, *held):  # ½ ċ²: a unit "inertia" that the impact of a footfall leaves alone
+        out.inertia(c, 1)
     extra = sp.zeros(len(held) + 1, 1)
     out._forces = [f.col_join(extra) for f in m._forces]
     law = m.control_law  # saturated as declared
@@ -90,7 +91,8 @@ def sample_and_hold(system: HybridSystem, rate: float) -> HybridSystem:
                 **{str(h): law[j] for j, h in enumerate(held)}}
         vmap = {**{str(v): v for v in m.qd[:n0]}, str(m.dot(clock)): sp.Integer(1),
                 **{str(m.dot(h)): sp.Integer(0) for h in held}}
-        out.transition("sample" if len(modes) == 1 else f"sample_{name}", name, Guard(clock - 1 / rate, +1), Explicit(qmap, vmap), name)
+        label = "sample" if len(modes) == 1 else f"sample_{name}"
+        out.transition(label, name, Guard(clock - 1 / rate, +1), Explicit(qmap, vmap), name)
         start = system.default_start.get(name)
         if start is not None:
             subs = {**dict(zip([*m.q[:n0], *m.qd[:n0]], start)), **m.params}

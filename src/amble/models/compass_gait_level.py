@@ -1,5 +1,6 @@
-"""Compass gait on level ground under controlled symmetry (Spong & Bullo 2005): it walks the
-passive gait of a slope it only emulates.
+"""Compass gait on level ground under controlled symmetry (Spong & Bullo 2005).
+
+It walks the passive gait of a slope it only emulates.
 
 The model is the compass gait of Section 4.1 (Table 2 parameters; coordinates as in
 ``compass-gait``: absolute leg angles from the vertical, foot → hip, positive forward) with two
@@ -23,7 +24,7 @@ import sympy as sp
 from amble import POSITIVE, Model, R, walker
 
 NAME = "compass-gait-level"
-POSITION = 11  # after compass-gait
+POSITION = 45  # after the thesis models
 
 
 def build():

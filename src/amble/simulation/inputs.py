@@ -112,7 +112,8 @@ def work_per_step(traj: Trajectory, absolute: bool = False) -> dict[str, np.ndar
     actuator that cannot recover energy spends."""
     power = joint_power(traj)
     segs = _segments(traj)
-    return {k: np.array([_integrate(traj, np.abs(p) if absolute else p, a, b) for a, b in segs]) for k, p in power.items()}
+    return {k: np.array([_integrate(traj, np.abs(p) if absolute else p, a, b) for a, b in segs])
+            for k, p in power.items()}
 
 
 def cost_of_transport(traj: Trajectory) -> float:
