@@ -117,6 +117,8 @@ class _Program:
             d = sp.diff(e, s)
             if d.has(sp.DiracDelta):
                 d = d.replace(sp.DiracDelta, lambda *a: sp.Integer(0))
+            if d.has(sp.Heaviside, sp.sign):  # derivatives of Min, Max, Abs: printable branches
+                d = d.rewrite(sp.Piecewise)
             if d == 0:
                 continue
             coef = self._new(self.pr.doprint(d))

@@ -7,6 +7,7 @@
 #ifndef AMBLE_CORE_H
 #define AMBLE_CORE_H
 #include <math.h>
+#include <stdbool.h> /* derivatives of saturations print `true`/`false` conditions */
 #include <string.h>
 
 /* Error codes returned by kernels (0 = ok). */
