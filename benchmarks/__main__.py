@@ -1,6 +1,7 @@
 """Run the benchmark suite, print the tables and write ``BENCHMARKS.md``.
 
-Usage: ``python -m benchmarks [--quick] [--only derive,walk,startup,sweep,gaitopt,jacobian] [--output PATH | --no-write]``.
+Usage: ``python -m benchmarks [--quick] [--only derive,walk,startup,sweep,gaitopt,jacobian]
+[--output PATH | --no-write]``.
 ``--quick`` shrinks every benchmark (fewer chain sizes, 20 walking steps) for a smoke run; the
 published numbers come from a full run.
 """
