@@ -20,13 +20,18 @@ Everything here is a declaration; :mod:`amble.codegen` turns it into compiled co
 
 from __future__ import annotations
 
+import dataclasses
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import sympy as sp
+from sympy.core.relational import Relational
 
 from ..errors import ModelError, ParameterError
+from .expressions import checked_expr
+from .geometry import t as _TIME
 from .model import Model
 
 
@@ -167,7 +172,7 @@ class HybridSystem:
         target = target or source
         self._check_mode(source)
         self._check_mode(target)
-        self._check_guard(source, guard)
+        guard = self._check_guard(source, guard)
         _check_reset(self.modes[source], self.modes[target], reset, name)
         tr = Transition(name, source, target, guard, reset, None, step)
         self.transitions.append(tr)
@@ -185,7 +190,7 @@ class HybridSystem:
         for src in sources:
             self._check_mode(src)
             g = guard if isinstance(guard, Guard) else guard(self.modes[src])
-            self._check_guard(src, g)
+            g = self._check_guard(src, g)
             tr = Transition(name if len(sources) == 1 else f"{name}_{src}", src, src, g, None, status, False)
             self.transitions.append(tr)
         assert tr is not None
@@ -265,22 +270,78 @@ class HybridSystem:
         if mode not in self.modes:
             raise ModelError(f"system {self.name!r}: unknown mode {mode!r} (modes: {', '.join(self.modes)})")
 
-    def _check_guard(self, source: str, guard: Guard) -> None:
+    def _check_guard(self, source: str, guard: Any) -> Guard:
+        """``guard`` checked against mode ``source`` and normalised for code generation: the
+        expression and the enabling condition as sympy objects in the mode's symbols (text is
+        read with them), the direction an ``int``, an enabling condition that always holds
+        dropped. Anything the compiled code could not express is a :class:`ModelError` here
+        rather than a C compiler's complaint about ``true``, ``I`` or ``Sum``."""
         m = self.modes[source]
-        if guard.direction not in (-1, 0, 1):
-            raise ModelError(f"system {self.name!r}: guard direction must be -1, 0 or +1")
-        expr = sp.sympify(guard.expr)
-        allowed = set(m.q) | set(m.qd) | set(m.params) | {sp.Symbol("t", real=True)}
+        what = f"guard of mode {source!r}"
+        if not isinstance(guard, Guard):
+            raise ModelError(f"system {self.name!r}: a {what} must be a Guard, got {type(guard).__name__}")
+        d = guard.direction
+        # True == 1 in Python, but a flag where a direction belongs is a mistake (and reached C as 'True')
+        if isinstance(d, bool) or not isinstance(d, numbers.Real) or d not in (-1, 0, 1):
+            raise ModelError(f"system {self.name!r}: {what}: direction must be -1, 0 or +1, got {d!r}")
+        names = {str(s_): s_ for s_ in [*m.q, *m.qd, *m.params, _TIME]}
+        expr = checked_expr(self.name, _read(guard.expr, names, f"system {self.name!r}: {what}: "), what)
+        allowed = set(m.q) | set(m.qd) | set(m.params) | {_TIME}
         if not (expr.free_symbols & (set(m.q) | set(m.qd))):
             raise ModelError(
                 f"system {self.name!r}: a guard of mode {source!r} does not depend on the state: {expr}"
             )
-        for e in (expr, sp.sympify(guard.enabled) if guard.enabled is not None else sp.true):
+        enabled = _condition(self.name, guard.enabled, names, f"{what}: enabling condition")
+        for e in (expr, enabled if enabled is not None else sp.true):
             bad = sorted(str(s) for s in e.free_symbols - allowed)
             if bad:
                 raise ModelError(
                     f"system {self.name!r}: guard of mode {source!r} uses unknown symbols {', '.join(bad)}"
                 )
+        return dataclasses.replace(guard, expr=expr, direction=int(d), enabled=enabled)
+
+
+def _read(value: Any, names: Mapping[str, sp.Symbol], where: str = "") -> Any:
+    """Text parsed with the mode's own symbols (``"x > 0"`` means the real coordinate ``x``);
+    anything else unchanged. Unparsable text is a :class:`ModelError`."""
+    if not isinstance(value, str):
+        return value
+    try:
+        return sp.sympify(value, locals=dict(names))
+    except (sp.SympifyError, TypeError, SyntaxError) as e:
+        raise ModelError(f"{where}cannot read {value!r} as an expression ({type(e).__name__})") from None
+
+
+def _condition(system: str, value: Any, names: Mapping[str, sp.Symbol], what: str) -> Any:
+    """An enabling condition as a sympy boolean of comparisons, or ``None`` if it always holds.
+
+    Comparisons (``<``, ``>``, ``Eq`` ...) of checked expressions, joined by ``&``, ``|``, ``~``,
+    are accepted; a condition that is always false (the guard could never fire), a number, a
+    bare symbol or anything else is a :class:`ModelError`."""
+    if value is None:
+        return None
+    try:
+        e = sp.sympify(_read(value, names, f"system {system!r}: {what}: "))
+    except (sp.SympifyError, TypeError, SyntaxError):
+        raise ModelError(f"system {system!r}: {what} is not a condition: {value!r}") from None
+    if e is sp.true:
+        return None
+    if e is sp.false:
+        raise ModelError(f"system {system!r}: {what} is always false, so the guard could never fire: {value!r}")
+    _check_condition(system, e, what)
+    return e
+
+
+def _check_condition(system: str, e: Any, what: str) -> None:
+    if isinstance(e, (sp.And, sp.Or, sp.Not, sp.Xor)):
+        for a in e.args:
+            _check_condition(system, a, what)
+    elif isinstance(e, Relational):
+        for side in (e.lhs, e.rhs):
+            checked_expr(system, side, what)
+    else:
+        raise ModelError(f"system {system!r}: {what} must be a comparison such as foot_x > 0 (or several joined "
+                         f"by &, |, ~), got {e!r}")
 
 
 def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = False,
