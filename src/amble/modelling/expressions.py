@@ -11,7 +11,6 @@ from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
 
-
 #: Operations sympy keeps unevaluated that compiled code cannot express.
 _UNEVALUATED = (sp.Sum, sp.Product, sp.Integral, sp.Derivative, sp.Limit)
 
