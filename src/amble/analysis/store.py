@@ -419,4 +419,5 @@ class SweepResult:
         return {"ok": ok, "failed": len(self.rows) - ok}
 
 
-__all__ = ["COLUMN_TYPES", "ResultFileWarning", "ResultStore", "SweepResult", "fmt_value", "parse_value", "state_columns", "state_from_row"]
+__all__ = ["COLUMN_TYPES", "ResultFileWarning", "ResultStore",
+           "SweepResult", "fmt_value", "parse_value", "state_columns", "state_from_row"]

@@ -13,7 +13,6 @@ from pathlib import Path
 
 from ..errors import AmbleError, OutputError
 
-
 #: Most points of a sweep grid (all ranges together): a million rows of results take about a
 #: gigabyte in memory, and the grid itself is allocated before any work.
 MAX_GRID_POINTS = 1_000_000
