@@ -276,7 +276,7 @@ def _reason(e: OSError) -> str:
     """An OS error in words (a full disk named as such)."""
     if e.errno == errno.ENOSPC:
         return "no space left on device"
-    return e.strerror or str(e) or type(e).__name__
+    return e.strerror or (os.strerror(e.errno) if e.errno else "") or str(e) or type(e).__name__
 
 
 def _is_type(text: str, kind: str) -> bool:

@@ -35,7 +35,7 @@ def write_output(path: Path, write: Callable[[Path], Any], what: str) -> Path:
     except OSError as e:
         if isinstance(e, OutputError):
             raise
-        reason = e.strerror or str(e) or type(e).__name__
+        reason = e.strerror or (os.strerror(e.errno) if e.errno else "") or str(e) or type(e).__name__
         raise OutputError(f"{what}: cannot write {str(path)!r}: {reason}") from None
     finally:
         try:
