@@ -260,7 +260,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     with warnings.catch_warnings():
         warnings.showwarning = _one_line_warning
-        return _main(argv)
+        try:
+            return _main(argv)
+        except BrokenPipeError:
+            # the reader went away (``amble models | head -1``), perhaps while an error was being
+            # reported: stop quietly, as Unix tools do when SIGPIPE ends them, and keep Python from
+            # complaining again when it flushes standard output at exit
+            _quiet_stdout()
+            return 141
 
 
 def _main(argv: list[str]) -> int:
@@ -273,10 +280,7 @@ def _main(argv: list[str]) -> int:
         sys.stdout.flush()  # a closed pipe is found here, not at interpreter exit
         return 0
     except BrokenPipeError:
-        # the reader went away (``amble models | head -1``): stop quietly, as Unix tools do when
-        # SIGPIPE ends them, and keep Python from complaining again when it flushes at exit
-        _quiet_stdout()
-        return 141
+        raise  # handled in main()
     except AmbleError as e:
         msg = str(e).splitlines()[0] if str(e) else type(e).__name__
         if want_json:
