@@ -105,9 +105,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         write_output(plot_p, lambda part: plot_trajectory(tr, part), "--plot")
         summary["plot"] = str(plot_p)
     if anim_p:
-        from ..viz.animate import animate
-
-        write_output(anim_p, lambda part: animate(tr, part), "--animate")
+        _animate(tr, anim_p)
         summary["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {tr.status} — {tr.message}")
@@ -118,6 +116,17 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
             if k in summary:
                 print(f"wrote {summary[k]}")
     return summary
+
+
+def _animate(tr: Any, path: Any) -> None:
+    """Write the animation of ``tr``: a GIF or MP4 is written atomically by the movie writer itself
+    (its messages name the file), an HTML page through a part file."""
+    from ..viz.animate import animate
+
+    if path.suffix.lower() in (".gif", ".mp4"):
+        animate(tr, path)
+    else:
+        write_output(path, lambda part: animate(tr, part), "--animate")
 
 
 def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
@@ -147,9 +156,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
             write_output(plot_p, lambda part: plot_limit_cycle(tr, part, cycle=lc), "--plot")
             out["plot"] = str(plot_p)
         if anim_p:
-            from ..viz.animate import animate
-
-            write_output(anim_p, lambda part: animate(tr, part), "--animate")
+            _animate(tr, anim_p)
             out["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
