@@ -9,6 +9,7 @@ import csv
 import errno
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -106,6 +107,39 @@ def test_a_read_only_directory_is_refused_before_the_work(capsys, tmp_path):
         _error(capsys, [*SWEEP, "--out", str(out)], "cannot")
     finally:
         out.parent.chmod(0o700)
+
+
+def _read_only_mounts_work() -> bool:
+    """Whether this process may make a private read-only bind mount (root with unshare)."""
+    if not sys.platform.startswith("linux") or os.geteuid() != 0 or shutil.which("unshare") is None:
+        return False
+    probe = subprocess.run(["unshare", "-m", "sh", "-c", "mount --bind /tmp /tmp && mount -o remount,bind,ro /tmp"],
+                           capture_output=True, timeout=30)
+    return probe.returncode == 0
+
+
+@pytest.mark.skipif(not _read_only_mounts_work(), reason="needs root and unshare for a read-only bind mount")
+def test_a_writable_file_in_a_read_only_directory_is_refused_before_the_work(tmp_path):
+    # the file itself writable (bind-mounted read-write), its directory read-only: compaction,
+    # which replaces the file through a temporary one beside it, once failed after all the work
+    # with an untyped "OSError: [Errno 30] Read-only file system"
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    for name in ("s.csv", ".s.csv.lock"):
+        (ro / name).write_text("")
+        (tmp_path / name).write_text("")
+    script = ("from amble.analysis.sweep import sweep_fixed_points; from amble.models import load; "
+              f"sweep_fixed_points(load('compass-gait'), 'slope', [0.04, 0.05], out={str(ro / 's.csv')!r}, "
+              "scheduler='synchronous', progress=False)")
+    mounts = (f"mount --bind {ro} {ro} && mount -o remount,bind,ro {ro} && "
+              f"mount --bind {tmp_path / 's.csv'} {ro / 's.csv'} && "
+              f"mount --bind {tmp_path / '.s.csv.lock'} {ro / '.s.csv.lock'}")
+    proc = subprocess.run(["unshare", "-m", "sh", "-c", f'{mounts} && exec "$0" -c "$1"', sys.executable, script],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode != 0
+    last = proc.stderr.strip().splitlines()[-1]
+    assert last.startswith("amble.errors.OutputError: cannot write result file") and "Read-only" in last, last
+    assert (tmp_path / "s.csv").read_text() == ""  # nothing was computed, nothing written
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])

@@ -99,16 +99,16 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
     if p.exists():
         if not p.is_file():
             raise OutputError(f"{what}: {path!r} exists and is not a file")
-        if not os.access(p, os.W_OK):
-            raise OutputError(f"{what}: cannot write {path!r} (permission denied)")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{what}: cannot create {path!r} in {str(parent)!r} (permission denied)")
+        try:
+            open(p, "ab").close()  # opening to append changes nothing
+        except OSError as e:
+            raise OutputError(f"{what}: cannot write {path!r} ({e.strerror or e})") from None
     try:
         fd, probe = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".probe", dir=parent)
         os.close(fd)
         os.unlink(probe)
     except OSError as e:
-        raise OutputError(f"{what}: cannot create {path!r} in {str(parent)!r} ({e.strerror or e})") from None
+        raise OutputError(f"{what}: cannot create files in {str(parent)!r} ({e.strerror or e})") from None
     return p
 
 
