@@ -142,6 +142,24 @@ def test_a_writable_file_in_a_read_only_directory_is_refused_before_the_work(tmp
     assert (tmp_path / "s.csv").read_text() == ""  # nothing was computed, nothing written
 
 
+@pytest.mark.skipif(not _read_only_mounts_work(), reason="needs root and unshare for a private small tmpfs")
+def test_a_really_full_disk_is_one_line_and_leaves_no_file(tmp_path):
+    # a 64 KiB file system: the samples of 10 steps do not fit
+    full = tmp_path / "full"
+    full.mkdir()
+    outs = ["w.csv", "w.parquet", "w.npz"]
+    runs = "; ".join(f'"$0" -m amble.cli simulate compass-gait --steps 10 --out {full / o} 2>&1; echo "rc=$?"'
+                     for o in outs)
+    shell = f"mount -t tmpfs -o size=64k tmpfs {full} && {runs}; ls -A {full}"
+    proc = subprocess.run(["unshare", "-m", "sh", "-c", shell, sys.executable], capture_output=True, text=True,
+                          timeout=300)
+    lines = proc.stdout.strip().splitlines()
+    for o, (err, rc) in zip(outs, zip(lines[0:6:2], lines[1:6:2])):
+        assert rc == "rc=2" and err.startswith(f"amble: error: --out: cannot write '{full / o}'"), (err, rc)
+        assert "No space left on device" in err
+    assert len(lines) == 6, lines  # and `ls -A` listed nothing: no partial or part files
+
+
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_a_failed_compaction_keeps_the_journal_and_the_rerun_finishes(capsys, tmp_path, monkeypatch, suffix):
     ref = tmp_path / f"ref{suffix}"
