@@ -99,3 +99,27 @@ def test_an_always_true_condition_fires_like_none():
     tr = amble.simulate(s, [1.0, 0.0], t_end=0.5, samples=False)
     assert [e.name for e in tr.events] == ["bounce"]
     assert tr.events[0].t == pytest.approx(math.sqrt(2 / 9.81), rel=1e-9)
+
+
+@pytest.mark.parametrize("qd, needle", [
+    ([sp.I * sp.Symbol("y_dot", real=True)], "complex"),  # once CompileError: 'I' undeclared
+    ([sp.zoo * sp.Symbol("y_dot", real=True)], "infinite"),  # once PrintMethodNotImplementedError
+    ([sp.Sum(sp.Symbol("y_dot", real=True) ** _n, (_n, 1, 2))], "unevaluated Sum"),  # once 'Sum' undeclared
+    ([sp.Function("f")(sp.Symbol("y_dot", real=True))], "undefined function"),  # once PrintMethodNotImplementedError
+    ([None], "must be an expression"),  # once AttributeError: 'NoneType' object has no attribute 'free_symbols'
+    (None, "mapping or a sequence"),
+    ("y_dot", "mapping or a sequence"),
+])
+def test_resets_compiled_code_could_not_express_are_model_errors(qd, needle):
+    m, y, _ = _ball("reset-bad")
+    with pytest.raises(ModelError, match=needle):
+        HybridSystem(m.name, m).transition("bounce", m.name, Guard(y), Explicit(q=[y], qd=qd))
+
+
+def test_a_text_reset_reads_the_source_modes_symbols():
+    # a ball dropped from 1 m reaches the floor at v = sqrt(2 g h) and leaves it at half that speed
+    m, y, _ = _ball("reset-text")
+    s = HybridSystem(m.name, m)
+    s.transition("bounce", m.name, Guard(y), Explicit(q=["y"], qd=["-y_dot/2"]))
+    tr = amble.simulate(s, [1.0, 0.0], t_end=0.5, samples=False)
+    assert tr.events[0].x_post[1] == pytest.approx(math.sqrt(2 * 9.81) / 2, rel=1e-8)

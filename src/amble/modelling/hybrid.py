@@ -347,10 +347,20 @@ def _check_condition(system: str, e: Any, what: str) -> None:
 def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = False,
                  source: Model | None = None) -> list[sp.Expr]:
     """Order a relabel mapping (or sequence) by the target mode's coordinates. With a mapping, a
-    target coordinate that the source mode also has and the mapping omits is kept as it is."""
+    target coordinate that the source mode also has and the mapping omits is kept as it is.
+
+    Each value is a checked expression (:func:`~amble.modelling.expressions.checked_expr`: no
+    ``I``, ``zoo``, unevaluated ``Sum`` or undefined function reaches the compiler); text is read
+    with the source mode's symbols."""
     names = [str(s) for s in (target.qd if velocities else target.q)]
+    known = {str(s_): s_ for s_ in [*source.q, *source.qd, *source.params, _TIME]} if source is not None else {}
+    model = source.name if source is not None else target.name
+
+    def value(v: Any) -> sp.Expr:
+        return checked_expr(model, _read(v, known, f"{what}: "), what)
+
     if isinstance(mapping, Mapping):
-        given = {str(k): sp.sympify(v) for k, v in mapping.items()}
+        given = {str(k): value(v) for k, v in mapping.items()}
         unknown = sorted(set(given) - set(names))
         if unknown:
             raise ModelError(f"{what}: {', '.join(unknown)} not among the target coordinates {names}")
@@ -361,7 +371,9 @@ def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = Fals
         if missing:
             raise ModelError(f"{what}: no value for target coordinate(s) {', '.join(missing)}")
         return [given[n] for n in names]
-    seq = [sp.sympify(v) for v in (list(mapping) if not isinstance(mapping, sp.MatrixBase) else list(mapping))]
+    if isinstance(mapping, (str, bytes)) or not isinstance(mapping, (Sequence, sp.MatrixBase)):
+        raise ModelError(f"{what}: expected a mapping or a sequence of {len(names)} values, got {mapping!r}")
+    seq = [value(v) for v in list(mapping)]
     if len(seq) != len(names):
         raise ModelError(f"{what}: {len(seq)} values for {len(names)} target coordinates")
     return seq
@@ -375,7 +387,7 @@ def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
         exprs = target_exprs(dst, reset.relabel, what, source=src)
         _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
     elif isinstance(reset, Lock):
-        c = sp.sympify(reset.constraint)
+        c = checked_expr(src.name, reset.constraint, f"{what}: lock constraint")
         if not (c.free_symbols & set(src.q)):
             raise ModelError(f"{what}: lock constraint {c} does not depend on the coordinates")
         exprs = target_exprs(dst, reset.relabel, what, source=src)
