@@ -85,3 +85,25 @@ def test_json_error_object(capsys):
 def test_console_script_help_has_an_example():
     r = subprocess.run([sys.executable, "-m", "amble.cli", "simulate", "--help"], capture_output=True, text=True)
     assert r.returncode == 0 and "example:" in r.stdout
+
+
+def test_period_two_reports_both_points_and_step_times(capsys):
+    """Beyond the flip (slope 0.08) the orbit alternates two steps of different length: both
+    section points and both step times are reported, not only their mean."""
+    code, out, _ = run(capsys, "limit-cycle", "compass-gait", "--set", "slope=0.08", "--period", "2", "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert d["period"] == 2 and len(d["orbit"]) == 2 and len(d["step_times"]) == 2
+    t1, t2 = d["step_times"]
+    assert abs(t1 - t2) > 0.05 and (t1 + t2) / 2 == pytest.approx(d["step_time"], rel=1e-12)
+    assert abs(d["orbit"][0][0] - d["orbit"][1][0]) > 1e-2  # two distinct stance angles
+    code, out, _ = run(capsys, "limit-cycle", "compass-gait", "--set", "slope=0.08", "--period", "2")
+    assert out.count("step time") == 3  # the mean, then each of the two steps
+
+
+def test_period_two_search_that_finds_period_one_says_so(capsys):
+    code, out, _ = run(capsys, "limit-cycle", "compass-gait", "--period", "2")
+    assert code == 0 and "the period-2 search converged to a period-1 gait" in out
+    code, out, _ = run(capsys, "limit-cycle", "compass-gait", "--period", "2", "--json")
+    d = json.loads(out)
+    assert d["period"] == 1 and d["requested_period"] == 2

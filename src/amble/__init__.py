@@ -16,6 +16,7 @@ from .errors import (
     SimulationError,
     StateError,
 )
+from .modelling.contact import RoundFoot, rolling_centre, round_foot
 from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval
 from .modelling.geometry import R3, R, t, vector
 from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
@@ -30,7 +31,7 @@ from .viz import animate, plot_limit_cycle, plot_trajectory
 __all__ = [
     "NONNEGATIVE", "POSITIVE", "R", "R3", "AmbleError", "CompileError", "ConvergenceError", "Domain", "Equations",
     "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
-    "ParameterError", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
+    "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
     "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
-    "plot_limit_cycle", "plot_trajectory", "simulate", "t", "vector", "walker",
+    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "simulate", "t", "vector", "walker",
 ]

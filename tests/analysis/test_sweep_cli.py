@@ -15,6 +15,7 @@ import amble.cli.sweep as cli_sweep
 from amble import OutputError, SchedulerError
 from amble.analysis.basin import basin
 from amble.analysis.bifurcation import bifurcation
+from amble.analysis.continuation_sweep import sweep_continuation
 from amble.analysis.defaults import BASIN_STEPS, BASIN_TOL, BIFURCATION_TOL, FIXED_POINT_TOL
 from amble.analysis.fixed_points import sweep_fixed_points, sweep_fixed_points_2d
 from amble.analysis.poincare import find_fixed_point
@@ -53,12 +54,14 @@ def test_api_defaults_come_from_one_place():
     assert _default(bifurcation, "rtol") == _default(bifurcation, "atol") == BIFURCATION_TOL
     assert _default(basin, "rtol") == _default(basin, "atol") == BASIN_TOL
     assert _default(basin, "steps") == BASIN_STEPS
+    assert _default(sweep_continuation, "rtol") == _default(sweep_continuation, "atol") == FIXED_POINT_TOL
 
 
 @pytest.mark.parametrize("kind, grid, fn", [
     ("fixed-point", ["--param", "slope=0.04:0.05:2"], "sweep_fixed_points"),
     ("fixed-point", ["--param", "slope=0.04:0.05:2", "--param", "mh=9:10:2"], "sweep_fixed_points_2d"),
     ("bifurcation", ["--param", "slope=0.04:0.05:2"], "bifurcation"),
+    ("continuation", ["--param", "slope=0.04:0.05"], "sweep_continuation"),
     ("basin", ["--x", "stance=-0.3:-0.2:2", "--x", "stance_dot=1:1.2:2"], "basin"),
 ])
 def test_given_tolerance_is_used_and_absent_one_is_the_api_default(monkeypatch, kind, grid, fn):

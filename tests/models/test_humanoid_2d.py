@@ -97,3 +97,17 @@ def test_step_length_torque_does_the_work_of_eq_35(humanoid):
         L = -k.kinematics_rows([0.0], [0], x, on)[0][0, foot, 0]
         expected = -kleg * L * x[6] if L > 0 else 0.0
         assert power(x, on) - power(x, off) == pytest.approx(expected, abs=1e-7)
+
+
+def test_multipliers_do_not_depend_on_where_newton_stopped(humanoid):
+    """Exact Jacobians: multipliers from two states 1e-11 apart on the cycle agree to 1e-9 (with
+    central differences of step 1e-5 they moved by ~7e-7)."""
+    from amble.analysis.poincare import ReturnMap
+
+    lc = find_fixed_point(humanoid)
+    P = ReturnMap(humanoid)
+    mus = [np.sort_complex(np.linalg.eigvals(P.section_jacobian(lc.fixed_point + dx)[0])) for dx in (0.0, 1e-11)]
+    assert np.max(np.abs(mus[0] - mus[1])) < 1e-9
+    # and they agree with central differences to the differences' own error
+    fd = np.sort_complex(np.linalg.eigvals(P.section_jacobian(lc.fixed_point, "fd")[0]))
+    assert np.max(np.abs(fd - mus[0])) < 1e-5

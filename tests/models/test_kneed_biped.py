@@ -173,3 +173,31 @@ def test_hsu_chen_euler_fixed_point_converges_to_the_accurate_one_at_first_order
             x = euler_stride(k, p, x, dt)
         errors.append(np.max(np.abs(x - exact)))
     assert errors[0] / errors[1] == pytest.approx(4.0, rel=0.25)
+
+
+#: the three slopes of Hsu Chen's parameters: her code's asin(7.25/144), her thesis' 0.0504, and 0.06
+HSU_CHEN_SLOPES = [float(np.arcsin(7.25 / 144)), 0.0504, 0.06]
+
+
+@pytest.mark.parametrize("slope", [*HSU_CHEN_SLOPES, 0.04, 0.07])
+def test_default_search_finds_the_stable_gait_at_hsu_chens_parameters(kneed, slope):
+    params = dict(HSU_CHEN, slope=slope)
+    lc = find_fixed_point(kneed, params=params)
+    assert lc.residual < 1e-9 and lc.stable
+    # stable in fact, not only by its multipliers: a perturbed walker returns to the cycle
+    tr = simulate(kneed, lc.fixed_point + np.array([0.0, 0.0, 0.0, 0.02, -0.03, -0.03]), params=params, steps=40)
+    assert tr.status == "completed"
+    np.testing.assert_allclose(tr.final_post_impact_state, lc.fixed_point, atol=1e-5)
+    if slope == HSU_CHEN_SLOPES[0]:  # docs/references.md 3a [R]: the independent port, 0.564578 s
+        assert lc.step_time == pytest.approx(0.564578, abs=1e-6)
+    if slope == 0.06:  # not the unstable gait of 0.474 s, |μ| 3.60, that lies nearer the model's default gait
+        assert lc.step_time == pytest.approx(0.5754, abs=1e-3)
+
+
+def test_an_explicit_guess_is_followed_even_to_an_unstable_gait(kneed):
+    # the unstable cycle at slope 0.06 exists; a guess near it finds it (the search does not
+    # swap a cycle the caller asked for)
+    guess = [-0.18746, 0.30746, 0.30746, 1.32788, 0.50149, 0.50149]
+    lc = find_fixed_point(kneed, guess, params=dict(HSU_CHEN, slope=0.06))
+    assert not lc.stable and lc.step_time == pytest.approx(0.4744, abs=1e-3)
+    assert max(abs(lc.multipliers)) == pytest.approx(3.60, abs=0.01)

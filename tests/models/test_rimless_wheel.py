@@ -55,6 +55,15 @@ def test_rolling_fixed_point_and_multiplier_match_closed_form(system, params):
     assert lc.stable
 
 
+@pytest.mark.parametrize("params", [DEFAULTS, OTHER], ids=["drake-defaults", "six-spokes"])
+def test_exact_multiplier_to_twelve_digits(system, params):
+    """The variational equations and the saltation matrix of the derived impact give the
+    multiplier to the integration tolerance (central differences stop near 1e-9)."""
+    lc = find_fixed_point(system, [params["slope"] - params["alpha"], omega_star(params)], params=params,
+                          rtol=1e-14, atol=1e-14, tol=1e-13)
+    assert abs(lc.multipliers[0] - math.cos(2 * params["alpha"]) ** 2) < 1e-12
+
+
 def test_default_fixed_point_search(system):
     lc = find_fixed_point(system)
     assert lc.fixed_point[1] == pytest.approx(omega_star(DEFAULTS), abs=1e-8)

@@ -20,12 +20,12 @@ from typing import Any
 import numpy as np
 
 from ..backend.kernels import build
-from ..errors import StateError
+from ..errors import ConvergenceError, StateError
 from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
-from .bifurcation import on_section
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
+from .section import Section
 from .sweep_runner import compiled, point_key, run_sweep
 
 #: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
@@ -71,30 +71,28 @@ class BasinResult:
     def counts(self) -> dict[str, int]:
         return {lab: int(np.sum(self.outcome == c)) for c, lab in enumerate(self.labels)}
 
-class SetCoordinates:
-    """Default map (a, b) → full state: put the two values into the base state.
+def _embed(k: Any, p: np.ndarray, section: tuple | None, idx: Sequence[int], S: Sequence[int]
+           ) -> Callable[[float, float, np.ndarray], np.ndarray]:
+    """The default map (a, b) → full state: the two values in the base state's section coordinates,
+    the rest of the state from the section (:meth:`Section.project`)."""
+    sec = None if section is None else Section(k, p, *section)
 
-    For a compass-like walker (coordinates ``stance`` and ``swing``, parameter ``slope``) with
-    ``swing`` not among the varied coordinates, the post-impact section constraint (both feet on
-    the slope) ``swing = 2·slope − stance`` is enforced (rad).
-    """
-
-    def __init__(self, state_names: Sequence[str], names: tuple[str, str], slope: float | None) -> None:
-        self.state_names = list(state_names)
-        self.idx = [self.state_names.index(n) for n in names]
-        # the section rule is enforced unless swing itself is one of the varied coordinates
-        self.section = {"slope": slope} if slope is not None and "swing" not in names else {}
-
-    def __call__(self, a: float, b: float, base: np.ndarray) -> np.ndarray:
+    def to_state(a: float, b: float, base: np.ndarray) -> np.ndarray:
         x = base.copy()
-        x[self.idx[0]], x[self.idx[1]] = a, b
-        return on_section(self.state_names, self.section, x)
+        x[idx[0]], x[idx[1]] = a, b
+        return x if sec is None else sec.project(x, S)
+
+    return to_state
 
 
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
-                base: list[float], fixed: list[float], to_state: Callable, steps: int, check_every: int, tol: float,
-                rtol: float, atol: float, x_names: Sequence[str]) -> list[dict[str, Any]]:
-    """One or more grid rows: walk each cell with the compiled run loop, no recording."""
+                base: list[float], fixed: list[float], to_state: Callable | None, steps: int, check_every: int,
+                tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None
+                ) -> list[dict[str, Any]]:
+    """One or more grid rows: walk each cell with the compiled run loop, no recording.
+
+    ``to_state`` ``None``: cells are put on the section (``section``: transition, time, pre-impact
+    state and the section coordinates; built here, in the worker, from the compiled kernels)."""
     k = build(system)
     mi = 0
     n = k.meta["nx"][mi]
@@ -102,12 +100,21 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     xs = np.asarray(fixed, float)
     b0 = np.asarray(base, float)
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
+    if to_state is None:
+        idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
+        to_state = _embed(k, p, None if section is None else tuple(section[:3]), idx,
+                          [] if section is None else section[3])
     out = []
     for i, a in rows:
         for j, b in enumerate(b_values):
-            x = np.asarray(to_state(a, b, b0), float)
             done, code, dist, reason = 0, 0, math.nan, ""
-            if x.shape != (n,) or not np.all(np.isfinite(x)):
+            try:
+                x = np.asarray(to_state(a, b, b0), float)
+            except ConvergenceError:  # no state of the section has these two coordinates here
+                x, code, reason = None, 3, "off the section"
+            if x is None:
+                pass
+            elif x.shape != (n,) or not np.all(np.isfinite(x)):
                 code, reason = 3, "invalid initial state"
             else:
                 while done < steps:
@@ -153,16 +160,20 @@ def basin(
     """Basin of attraction of the period-1 gait over two post-impact coordinates.
 
     The grid is ``n[0]`` values of ``x_names[0]`` over ``ranges[0]`` × ``n[1]`` values of
-    ``x_names[1]`` over ``ranges[1]``; the other coordinates come from ``base_state`` (default:
-    the fixed point at ``params``). ``to_state(a, b, base) → full state`` overrides the
-    embedding (default :class:`SetCoordinates`, which respects the compass gait's section). Each
+    ``x_names[1]`` over ``ranges[1]``; the other section coordinates come from ``base_state``
+    (default: the fixed point at ``params``) and the dependent coordinates from the section
+    (:meth:`amble.analysis.section.Section.project`: the cell's state lies on the post-impact
+    section of the step transition, whatever the model). The two coordinates must chart the
+    section together (:class:`StateError` otherwise: e.g. the two angles of a compass gait, tied by
+    both feet on the slope). A cell with no section state near the gait is ``failed`` with reason
+    ``off the section``. ``to_state(a, b, base) → full state`` overrides the embedding. Each
     cell walks up to ``steps`` footfalls (checked every ``check_every``) and is ``converged`` if
     ``|x − x*|∞ < tol``, ``fell`` if a terminal/fall event ended it, ``not converged`` if it kept
     walking elsewhere (another attractor or too slow), ``failed`` for any other run status.
     One Dask task per ``rows_per_task`` grid rows. ``rtol``/``atol``: integrator tolerances
     (looser than for fixed points: only the outcome category matters here).
     """
-    from .poincare import find_fixed_point
+    from .poincare import ReturnMap, find_fixed_point
 
     k, pvec, snames = compiled(system, params)
     for nm in x_names:
@@ -180,14 +191,21 @@ def basin(
     base = xs if base_state is None else np.asarray(base_state, float)
     if base.shape != xs.shape:
         raise StateError(f"base_state needs {xs.size} values ({', '.join(snames)})")
+    section = None
     if to_state is None:
-        slope = float(pvec[k.meta["params"].index("slope")]) if "slope" in k.meta["params"] else None
-        to_state = SetCoordinates(snames, x_names, slope)
+        sec = Section.of(ReturnMap(system, params, rtol=rtol, atol=atol), xs)
+        try:
+            S = sec.coordinates(prefer=[snames.index(nm) for nm in x_names])
+        except StateError:
+            free = ", ".join(snames[i] for i in sec.coordinates())
+            raise StateError(f"basin: {x_names[0]} and {x_names[1]} are tied on the section (they cannot both be "
+                             f"varied); section coordinates of this model: {free}") from None
+        section = (sec.tr, sec.t, sec.pre.tolist(), S.tolist())
     keys = [[point_key(i, j, float(a), float(b)) for j, b in enumerate(bv)] for i, a in enumerate(av)]
 
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
-                to_state, steps, check_every, tol, rtol, atol, list(x_names))
+                to_state, steps, check_every, tol, rtol, atol, list(x_names), section)
 
     res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
                     groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,
@@ -212,4 +230,4 @@ def basin(
                        state_names=snames, reasons=why)
 
 
-__all__ = ["BASIN_COLUMNS", "BASIN_LABELS", "BasinResult", "SetCoordinates", "basin", "basin_columns"]
+__all__ = ["BASIN_COLUMNS", "BASIN_LABELS", "BasinResult", "basin", "basin_columns"]

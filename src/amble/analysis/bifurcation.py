@@ -1,8 +1,8 @@
 """Bifurcation diagrams and Poincaré iterates: where the period-1 gait gives way to period 2, 4...
 
 Along a swept parameter the return map is iterated from the previous value's last post-impact
-state (first put on the new value's section, :func:`on_section`): a transient is dropped, then
-the iterates of one coordinate are kept and their period is read off. Unlike a fixed-point
+state (first put on the new value's section, :meth:`~amble.analysis.section.Section.project`): a
+transient is dropped, then the iterates of one coordinate are kept and their period is read off. Unlike a fixed-point
 branch this follows the *attractor*, so it shows the period-doubling cascade and where the
 walker falls.
 
@@ -25,19 +25,22 @@ from ..simulation.engine import Options, run
 from ..simulation.simulate import parameter_vector
 from .defaults import BIFURCATION_TOL
 from .runner import chunks, sweep_values
+from .section import Section
 from .store import ResultStore, SweepResult, state_columns
 from .sweep_runner import compiled, point_key, run_sweep, seed_before
 
 
-def on_section(state_names: Sequence[str], params: Mapping[str, float], x: np.ndarray) -> np.ndarray:
-    """Put a post-impact state of a compass-like walker (coordinates ``stance``, ``swing``,
-    parameter ``slope``) on the section of ``params``: ``swing = 2·slope − stance`` (both feet on
-    the slope, rad). Other systems: ``x`` unchanged."""
-    sn = list(state_names)
-    if "stance" in sn and "swing" in sn and "slope" in params:
-        x = np.array(x, float)
-        x[sn.index("swing")] = 2.0 * float(params["slope"]) - x[sn.index("stance")]
-    return x
+def _onto_section(system: HybridSystem, params: Mapping[str, float], x: np.ndarray, rtol: float,
+                  atol: float) -> np.ndarray:
+    """A state carried from the previous parameter value, put on the section of ``params`` with
+    its section coordinates kept (:meth:`Section.project`); unchanged when no footfall from it can
+    be found (the transient then reports why)."""
+    from .poincare import ReturnMap
+
+    try:
+        return Section.of(ReturnMap(system, params, rtol=rtol, atol=atol), x).project(x)
+    except AmbleError:
+        return x
 
 
 def _bif_columns(param: str, snames: Sequence[str]) -> dict[str, str]:
@@ -78,7 +81,7 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
         params = {**base, param: val}
         p = parameter_vector(k, params, system)
         if x is not None:  # the carried state must sit on the section of the new parameters
-            x = on_section(snames, dict(zip(k.meta["params"], p.tolist())), x)
+            x = _onto_section(system, params, x, rtol, atol)
         row: dict[str, Any] = {"i": i, param: val, "coordinate": snames[coord]}
         x0 = x
         if x0 is None:  # no state to carry: start on the period-1 fixed point (it exists past the flip)
@@ -141,8 +144,9 @@ def bifurcation(
     post-impact state, then ``keep`` more steps whose post-impact ``coordinate`` (name or state index; default the
     first, the stance angle of a walker, rad) is kept. A chunk's first value starts on its
     period-1 fixed point when one is found (else the model's guess walked in); a carried state
-    is first put on the new section (:func:`on_section`). ``period`` in a row: smallest p with
-    iterates repeating within ``period_tol`` (0 = no period found: chaos or slow transient).
+    is first put on the new section, its section coordinates kept (:mod:`amble.analysis.section`).
+    ``period`` in a row: smallest p with iterates repeating within ``period_tol`` (0 = no period
+    found: chaos or slow transient).
     A value where the walker falls is recorded ``failed`` with the reason.
     """
     v = sweep_values(values, param, system)
@@ -201,4 +205,4 @@ def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *
     return np.array(rows)
 
 
-__all__ = ["bifurcation", "first_period_doubling_iterates", "on_section", "poincare_iterates"]
+__all__ = ["bifurcation", "first_period_doubling_iterates", "poincare_iterates"]

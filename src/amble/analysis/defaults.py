@@ -22,6 +22,7 @@ BASIN_TOL = 1e-8
 BASIN_STEPS = 60
 
 #: The tolerance of each sweep kind, by its command-line name.
-SWEEP_TOL = {"fixed-point": FIXED_POINT_TOL, "bifurcation": BIFURCATION_TOL, "basin": BASIN_TOL}
+SWEEP_TOL = {"fixed-point": FIXED_POINT_TOL, "continuation": FIXED_POINT_TOL, "bifurcation": BIFURCATION_TOL,
+             "basin": BASIN_TOL}
 
 __all__ = ["BASIN_STEPS", "BASIN_TOL", "BIFURCATION_TOL", "FIXED_POINT_TOL", "RESIDUAL_TOL", "SWEEP_TOL"]

@@ -8,8 +8,11 @@ chart it best (pivoted QR) and drop the dependent ones; the return map in those 
 coordinates has a non-singular ``A − I`` at a hyperbolic fixed point, and the eigenvalues of
 ``A`` are the nontrivial Floquet multipliers.
 
-Fixed points are found by damped Newton in the reduced coordinates with a central-difference
-Jacobian (each column one compiled return-map evaluation, ~20–50 µs for the compass gait).
+Fixed points are found by damped Newton in the reduced coordinates with the exact Jacobian of the
+return map: one compiled run carries the variational equations along the flow and the saltation
+matrix through every event (``backend/_c/sensitivity.h``), so the derivative is that of the
+integrated map itself, to its tolerance. Central differences (``jacobian="fd"``) remain as a
+cross-check.
 """
 
 from __future__ import annotations
@@ -24,9 +27,11 @@ import numpy as np
 from ..backend.kernels import Kernels, build
 from ..errors import ConvergenceError, ModelError, SimulationError, StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.engine import Options, run
+from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .section import Section
+from .section import chart as _chart
 
 
 @dataclass
@@ -46,6 +51,12 @@ class LimitCycle:
     parameters: dict[str, float]
     jacobian: np.ndarray = field(repr=False)
     hybrid_system: Any = field(default=None, repr=False)
+    #: the k post-impact states of the orbit (the fixed point first) and the k step times (s)
+    orbit: np.ndarray | None = field(default=None, repr=False)
+    step_times: list[float] = field(default_factory=list)
+    #: the period asked for, when the orbit found has a lower one (a period-k search converged to
+    #: a period-d orbit repeated k/d times)
+    requested_period: int | None = None
 
     def trajectory(self, steps: int | None = None) -> Any:
         """Simulate the gait from the fixed point (default: two periods), samples every 5 ms."""
@@ -71,6 +82,9 @@ class LimitCycle:
             "residual": self.residual,
             "iterations": self.iterations,
             "period": self.period,
+            "requested_period": self.requested_period or self.period,
+            "orbit": self.orbit.tolist() if self.orbit is not None else [self.fixed_point.tolist()],
+            "step_times": self.step_times or [self.step_time],
             "parameters": self.parameters,
         }
 
@@ -78,7 +92,10 @@ class LimitCycle:
 #: Longest period a k-step return map is built for.
 MAX_PERIOD = 64
 #: A gait whose points move less than this fraction of the model's size over a period is at rest.
-REST_FRACTION = 1e-6
+#: Not 0: a passive walker on level ground loses a fraction ~θ² of its energy per impact, so a
+#: motion of amplitude θ ≈ 1e-4 has a return-map residual below any tolerance while it decays
+#: towards rest (its largest multiplier is 1 − O(θ²)): such a "fixed point" is not a gait.
+REST_FRACTION = 1e-3
 
 
 class ReturnMap:
@@ -116,6 +133,28 @@ class ReturnMap:
             raise SimulationError("return map: the walker did not come back to the section's mode")
         return r.x, r.t
 
+    def derivatives(self, x: np.ndarray, params: bool = True) -> tuple[np.ndarray, float, Sensitivity]:
+        """``P(x)``, the elapsed time and the exact derivatives of both with respect to ``x`` and
+        (with ``params``) the parameters: one compiled run with the variational equations."""
+        r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts,
+                sensitivities=True if params else "state")
+        if not r.completed:
+            raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
+        if r.mode != self.mi:
+            raise SimulationError("return map: the walker did not come back to the section's mode")
+        s = r.sensitivity
+        assert s is not None
+        if not (np.all(np.isfinite(s.dx_dx0)) and np.all(np.isfinite(s.dx_dp))):
+            raise SimulationError("return map: an event grazes its guard (ġ = 0), the map is not differentiable here")
+        return r.x, r.t, s
+
+    def section_jacobian(self, x: np.ndarray, method: str = "exact") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The map's Jacobian ``A`` in the section chart at ``x`` (its eigenvalues at a fixed
+        point are the nontrivial multipliers), the chart's state coordinates ``S`` and ``E``,
+        the map from chart increments to state increments. ``method``: ``"exact"`` or ``"fd"``."""
+        S, E = _chart(self.section_basis(x))
+        return _jacobian(self, x, E, S, method), S, E
+
     def last_impact(self, x: np.ndarray) -> tuple[int, float, np.ndarray]:
         """(transition index, time, pre-event state) of the last footfall when mapping ``x``."""
         r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, record=True,
@@ -131,48 +170,15 @@ class ReturnMap:
 
     def section_basis(self, x: np.ndarray) -> np.ndarray:
         """Orthonormal basis (n × d) of the section's tangent space near the image of ``x``."""
-        tr, t, xpre = self.last_impact(x)
-        k = self.k
-        src = k.mode_index(k.meta["transitions"][tr]["source"])
-        gi = [j for j, info in enumerate(k.meta["transitions"]) if info["source"] == k.meta["modes"][src]].index(tr)
-        n_pre = xpre.size
-        h = 1e-6
-        grad = np.zeros(n_pre)
-        for j in range(n_pre):
-            e = np.zeros(n_pre)
-            e[j] = h
-            grad[j] = (k.guards(src, t, xpre + e, self.p)[gi] - k.guards(src, t, xpre - e, self.p)[gi]) / (2 * h)
-        N = np.linalg.svd(grad[None, :])[2][1:].T  # null space of the guard gradient
-        DR = np.zeros((self.n, n_pre))
-        for j in range(n_pre):
-            e = np.zeros(n_pre)
-            e[j] = h
-            DR[:, j] = (k.reset(tr, t, xpre + e, self.p)[1] - k.reset(tr, t, xpre - e, self.p)[1]) / (2 * h)
-        T = DR @ N
-        U, s, _ = np.linalg.svd(T, full_matrices=False)
-        d = int(np.sum(s > 1e-7 * s[0]))
-        return U[:, :d]
+        return Section.of(self, x).tangent()
 
 
-def _chart(U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Coordinates that chart the tangent space best, and the map from their increments to states."""
-    # pivoted Gram–Schmidt on the rows of U (= QR with column pivoting of Uᵀ): pick, one at a
-    # time, the state coordinate whose tangent row is least explained by those already picked
-    R = U.copy()
-    piv: list[int] = []
-    for _ in range(U.shape[1]):
-        norms = np.linalg.norm(R, axis=1)
-        norms[piv] = -1.0
-        j = int(np.argmax(norms))
-        piv.append(j)
-        v = R[j] / np.linalg.norm(R[j])
-        R = R - np.outer(R @ v, v)
-    S = np.sort(np.array(piv))
-    E = U @ np.linalg.inv(U[S, :])  # n × d: increment of the chart coordinates → tangent vector
-    return S, E
-
-
-def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, h: float = 1e-5) -> np.ndarray:
+def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, method: str = "exact",
+              h: float = 1e-5) -> np.ndarray:
+    """The return map's Jacobian in chart coordinates: increments ``E ξ`` of the state, the
+    chart coordinates ``S`` of the image."""
+    if method == "exact":
+        return (P.derivatives(x, params=False)[2].dx_dx0 @ E)[S, :]
     cols = []
     for j in range(E.shape[1]):
         xp, _ = P(x + h * E[:, j])
@@ -206,40 +212,90 @@ def find_fixed_point(
     atol: float = FIXED_POINT_TOL,
     tol: float = RESIDUAL_TOL,
     max_iter: int = 40,
+    jacobian: str = "exact",
 ) -> LimitCycle:
     """Fixed point of the ``period``-step return map, its step time and Floquet multipliers.
 
     Damped Newton in reduced section coordinates; ``tol`` bounds the residual
-    ``|P(x) − x|∞`` of the returned post-impact state.
+    ``|P(x) − x|∞`` of the returned post-impact state. ``jacobian``: ``"exact"`` (variational
+    equations and saltation matrices) or ``"fd"`` (central differences, step 1e-5: a cross-check
+    whose error scales with the step squared). A period-k search that lands on an orbit of lower
+    period d reports period d and ``requested_period`` k.
+
+    Without a ``guess`` the search starts from :func:`default_guess`. At parameters other than
+    the defaults, when that search fails or finds an unstable cycle, the model's own gait (its
+    guess, on the cycle at the default parameters) is also followed to the requested parameters
+    by continuation, and the cycle found that way is returned if it is stable: a walker whose
+    default gait is stable finds the stable branch connected to it, not whichever cycle lies
+    nearest a poor guess.
     """
+    if jacobian not in ("exact", "fd"):
+        raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
     P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
     x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
-        return _newton(system, P, x, period, tol, max_iter)
+        direct = _newton(system, P, x, period, tol, max_iter, jacobian)
     except (SimulationError, ConvergenceError) as e:
         if guess is not None or not params:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
-    # The model's own guess lies on the cycle at its default parameters: follow the cycle from
-    # there to the requested parameters in a few continuation stages.
+        direct = None
+    at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
+    if direct is not None and (direct.stable or guess is not None or at_defaults):
+        return direct
+    found = [direct] if direct is not None else []
+    error = None
+    for geometric in (False, True):
+        try:
+            followed = _from_defaults(system, P, x0, geometric, period=period, rtol=rtol, atol=atol, tol=tol,
+                                      max_iter=max_iter, jacobian=jacobian)
+        except ConvergenceError as e:
+            error = error or e
+            continue
+        if followed.stable:
+            return followed
+        found.append(followed)
+    if found:
+        return found[0]
+    raise error
+
+
+def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, geometric: bool, stages: int = 16,
+                   **kw: Any) -> LimitCycle:
+    """The model's own guess lies on the cycle at its default parameters: follow the cycle from
+    there to the parameters of ``P`` in stages of ``1/stages`` of the way; a stage that fails is
+    halved (down to 1/32 of one), the next after a success doubled back, since cycles can move
+    fast near the target; at most ``3 × stages`` searches in all. The parameters move linearly,
+    or, with ``geometric``, those positive at both ends geometrically (masses, lengths and
+    gravity keep their ratios changing evenly)."""
     defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
     target = dict(zip(P.k.meta["params"], P.p.tolist()))
+
+    def at(s: float) -> dict[str, float]:
+        return {k: defaults[k] * (target[k] / defaults[k]) ** s if geometric and defaults[k] > 0 and target[k] > 0
+                else defaults[k] + s * (target[k] - defaults[k]) for k in target}
+
     x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
-    stages = 8
-    for i in range(1, stages + 1):
-        s = i / stages
-        stage = {k: defaults[k] + s * (target[k] - defaults[k]) for k in target}
+    done, step, lc = 0.0, 1.0 / stages, None
+    for searches in range(1, 3 * stages + 1):
+        s = min(1.0, done + step)
         try:
-            lc = find_fixed_point(system, x, params=stage, period=period, rtol=rtol, atol=atol, tol=tol,
-                                  max_iter=max_iter)
+            lc = find_fixed_point(system, x, params=target if s == 1.0 else at(s), **kw)
         except ConvergenceError as e:
-            raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
-                                   f"{i}/{stages} of the way ({e})") from None
-        x = lc.fixed_point
-    return lc
+            if step < 1.0 / (32 * stages) or searches == 3 * stages:
+                raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
+                                       f"{done:.0%} of the way ({e})") from None
+            step /= 2
+            continue
+        x, done, step = lc.fixed_point, s, min(2 * step, 1.0 / stages)
+        if done == 1.0:
+            return lc
+    raise ConvergenceError(f"no fixed point: continuation from the default parameters reached only {done:.0%} "
+                           f"of the way in {3 * stages} searches")
 
 
-def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int) -> LimitCycle:
+def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,
+            method: str = "exact", requested: int | None = None) -> LimitCycle:
     y, _ = P(x)  # start on the section
     it = 0
     res = math.inf
@@ -249,8 +305,7 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
         res = float(np.max(np.abs(r)))
         if res < tol:
             break
-        S, E = _chart(P.section_basis(y))
-        A = _jacobian(P, y, E, S)
+        A, S, E = P.section_jacobian(y, method)
         try:
             dxi = np.linalg.solve(A - np.eye(len(S)), -r[S])
         except np.linalg.LinAlgError:
@@ -275,18 +330,31 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
     _refuse_rest(system, P, xs, T)
     lower = _lower_period(P, xs, period, tol)
     if lower:
-        # the k-step orbit is a shorter one repeated: report that one
+        # the k-step orbit is a shorter one repeated: report that one, and that it was asked as k
         return _newton(system, ReturnMap(system, dict(zip(P.k.meta["params"], P.p.tolist())), period=lower,
-                                         rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter)
-    S, E = _chart(P.section_basis(xs))
-    A = _jacobian(P, xs, E, S)
+                                         rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter,
+                       method, requested or period)
+    A, S, E = P.section_jacobian(xs, method)
     mult = np.linalg.eigvals(A)
     mult = mult[np.argsort(-np.abs(mult))]
     names = P.k.meta["state_names"][P.mode]
+    orbit, times = _orbit(P, xs)
     return LimitCycle(system=system.name, mode=P.mode, state_names=list(names), fixed_point=xs, step_time=T / period,
                       multipliers=mult, section_coordinates=[names[i] for i in S],
                       residual=float(np.max(np.abs(Px - xs))), iterations=it, period=period,
-                      parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A, hybrid_system=system)
+                      parameters=dict(zip(P.k.meta["params"], P.p.tolist())), jacobian=A, hybrid_system=system,
+                      orbit=orbit, step_times=times, requested_period=requested)
+
+
+def _orbit(P: ReturnMap, x: np.ndarray) -> tuple[np.ndarray, list[float]]:
+    """The post-impact states after each step of one period (the fixed point first) and the
+    time of each step."""
+    r = run(P.k, P.p, P.mi, x, steps=P.period, opts=P.opts, record=True, events_only=True)
+    rec = r.recorded
+    step = [i for i, tr in enumerate(rec["etr"]) if P.k.meta["transitions"][int(tr)]["step"]]
+    times = np.diff(np.r_[0.0, rec["et"][step]]).tolist()
+    points = [x] + [rec["epost"][i][: P.k.meta["nx"][P.mi]] for i in step[:-1]]
+    return np.array(points), [float(v) for v in times]
 
 
 def _refuse_rest(system: HybridSystem, P: ReturnMap, x: np.ndarray, T: float) -> None:

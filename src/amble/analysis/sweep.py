@@ -7,9 +7,11 @@ This module gathers the public API of the sweep feature; each idea lives in its 
 - :mod:`amble.analysis.runner` — Dask clients (:func:`open_client`) and chunked execution;
 - :mod:`amble.analysis.fixed_points` — fixed-point branches (continuation) and 2D maps,
   :func:`period_doubling`;
-- :mod:`amble.analysis.bifurcation` — bifurcation diagrams, :func:`poincare_iterates`,
-  :func:`on_section`;
-- :mod:`amble.analysis.basin` — basins of attraction;
+- :mod:`amble.analysis.bifurcation` — bifurcation diagrams, :func:`poincare_iterates`;
+- :mod:`amble.analysis.continuation_sweep` — branches by pseudo-arclength continuation with their
+  folds, flips and period-doubled branches (:mod:`amble.analysis.continuation`);
+- :mod:`amble.analysis.basin` — basins of attraction, cells put on the post-impact section
+  (:mod:`amble.analysis.section`);
 
 Work is cut into chunks (consecutive parameter values, one row of a map or a basin), each one
 Dask task; chunks depend only on the grid, so a result does not depend on how many processes
@@ -24,12 +26,13 @@ Units: angles in rad, angular velocities in rad/s, times in s; parameters in the
 
 from __future__ import annotations
 
-from .basin import BASIN_LABELS, BasinResult, SetCoordinates, basin
-from .bifurcation import bifurcation, first_period_doubling_iterates, on_section, poincare_iterates
+from .basin import BASIN_LABELS, BasinResult, basin
+from .bifurcation import bifurcation, first_period_doubling_iterates, poincare_iterates
+from .continuation_sweep import sweep_continuation
 from .fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from .runner import open_client
 from .store import ResultStore, SweepResult
 
-__all__ = ["BASIN_LABELS", "BasinResult", "ResultStore", "SetCoordinates", "SweepResult", "basin", "bifurcation",
-           "first_period_doubling_iterates", "on_section", "open_client", "period_doubling", "poincare_iterates",
-           "sweep_fixed_points", "sweep_fixed_points_2d"]
+__all__ = ["BASIN_LABELS", "BasinResult", "ResultStore", "SweepResult", "basin", "bifurcation",
+           "first_period_doubling_iterates", "open_client", "period_doubling", "poincare_iterates",
+           "sweep_continuation", "sweep_fixed_points", "sweep_fixed_points_2d"]

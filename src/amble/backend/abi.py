@@ -58,7 +58,8 @@ OPT_FIELDS: tuple[str, ...] = ("TEND", "RTOL", "ATOL", "MAXSTEP", "MAXSTEPTIME",
 
 #: Fields of ``iopt`` (int64), in index order.
 IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZENON", "NSUB",
-                                "MAXISTEPS", "MAXISTEPS_EV", "YIELDN")
+                                "MAXISTEPS", "MAXISTEPS_EV", "YIELDN",
+                                "METHOD")  # integrator: 0 DOP853 (explicit), 1 Radau IIA (implicit, stiff)
 
 CTX = {name: i for i, name in enumerate(CTX_FIELDS)}
 OPT = {name: i for i, name in enumerate(OPT_FIELDS)}

@@ -12,78 +12,22 @@ the right-hand side is inlined into the integrator.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import sympy as sp
-from sympy.printing.c import C99CodePrinter
 
-from ..derivation.equations import Equations, derive
+from ..derivation.equations import derive
 from ..derivation.impact import impulse_data
 from ..derivation.switching import switching_surfaces
 from ..modelling.hybrid import Explicit, HybridSystem, target_exprs
-from ..modelling.model import Model, t
+from ..modelling.model import t
 from . import abi
-
-
-class _Printer(C99CodePrinter):
-    """C99 printer mapping symbols to array reads and avoiding pow() for small integer powers."""
-
-    def __init__(self, names: dict[sp.Symbol, str]) -> None:
-        super().__init__()
-        self._names = names
-
-    def _print_Symbol(self, expr: sp.Symbol) -> str:
-        name = self._names.get(expr)
-        return name if name is not None else super()._print_Symbol(expr)
-
-    _print_Dummy = _print_Symbol
-
-    def _print_Pow(self, expr: sp.Pow) -> str:
-        base, e = expr.base, expr.exp
-        if e.is_Integer and 2 <= int(e) <= 4:
-            b = self.parenthesize(base, 100)
-            return "(" + "*".join([b] * int(e)) + ")"
-        if e == -1:
-            return f"(1.0/{self.parenthesize(base, 100)})"
-        return super()._print_Pow(expr)
-
-
-@dataclass
-class ModeInfo:
-    model: Model
-    equations: Equations
-    index: int
-
-
-def _names(model: Model, params: list[str]) -> dict[sp.Symbol, str]:
-    n = len(model.q)
-    names: dict[sp.Symbol, str] = {t: "t"}
-    for i, s in enumerate(model.q):
-        names[s] = f"x[{i}]"
-    for i, s in enumerate(model.qd):
-        names[s] = f"x[{n + i}]"
-    for s in model.params:
-        names[s] = f"p[{params.index(str(s))}]"
-    return names
-
-
-def _block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ",
-           prelude: str = "") -> str:
-    """C statements assigning ``exprs`` to ``targets`` with shared subexpressions (after
-    ``prelude``, the statements of named intermediate quantities the expressions may use)."""
-    if not exprs:
-        return ""
-    repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
-    pr = _Printer(names)
-    lines = [prelude] if prelude else []
-    lines += [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
-    lines += [f"{indent}{tgt} = {pr.doprint(e)};" for tgt, e in zip(targets, reduced)]
-    return "\n".join(lines) + "\n"
-
-
-def _bool_block(expr: sp.Basic, names: dict[sp.Symbol, str]) -> str:
-    pr = _Printer(names)
-    return pr.doprint(expr)
+from .codegen_support import ModeInfo
+from .codegen_support import Printer as _Printer
+from .codegen_support import block as _block
+from .codegen_support import bool_expr as _bool_block
+from .codegen_support import symbol_names as _names
+from .variational_codegen import reset_jacobian_code, rhs_jacobian_code, surfaces_gradient_code
 
 
 def generate(system: HybridSystem) -> tuple[str, dict]:
@@ -111,6 +55,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
     w(abi.c_header())
     w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
+    w("#define SC (NXMAX + NPARAM)\n")  # columns of a sensitivity row: state, then parameters
     w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
     w(f"static const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")
     w(f"static const int MODE_TR0[NMODES] = {{{', '.join(map(str, tr0))}}};\n")
@@ -216,6 +161,20 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         w(f"    (void)t; (void)x; (void)p;\n    return ({cond}) ? 1 : 0;\n}}\n")
         w(_reset_code(i, tr, src, modes, nm, params))
 
+    # derivatives for sensitivity runs: flow Jacobians, surface gradients, reset Jacobians. Their
+    # straight-line code is an order of magnitude longer than the right-hand side's, and GCC's
+    # optimiser is superlinear in the length of a basic block (humanoid-3d: 8 s → 63 s at -O2);
+    # unoptimised they compile in seconds and cost a sensitivity run about 2× more
+    w("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC push_options\n#pragma GCC optimize (\"O0\")\n#endif\n")
+    for name, mi in modes.items():
+        nm = _names(mi.model, params)
+        surf = [sp.sympify(tr.guard.expr) for tr in trs_by_mode[name]] + list(switches[name])
+        w(rhs_jacobian_code(mi, nm, params))
+        w(surfaces_gradient_code(mi, surf, nm, params))
+    for i, tr in enumerate(order):
+        w(reset_jacobian_code(i, tr, modes[tr.source], modes, _names(modes[tr.source].model, params), params))
+    w("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC pop_options\n#endif\n")
+
     # dispatchers
     def dispatch(sig: str, ret: str, call: str, names: list[str], key: str) -> None:
         w(f"static {ret} {sig} {{\n    switch ({key}) {{\n")
@@ -245,6 +204,14 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
              "energy_{}(t, x, p, out)", mode_list, "mode")
     dispatch("kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel)",
              "void", "kinematics_{}(t, x, p, pos, vel)", mode_list, "mode")
+    dispatch("rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J)", "int",
+             "rhs_jac_{}(t, x, p, dx, J)", mode_list, "mode")
+    dispatch("rhs_jacp(int mode, double t, const double *x, const double *p, double *J)", "int",
+             "rhs_jacp_{}(t, x, p, J)", mode_list, "mode")
+    dispatch("surfaces_grad(int mode, double t, const double *x, const double *p, double *G)", "void",
+             "surfaces_grad_{}(t, x, p, G)", mode_list, "mode")
+    dispatch("reset_jac(int tr, double t, const double *x, const double *p, double *D)", "int",
+             "reset_jac_{}(t, x, p, D)", [tr.name for tr in order], "tr")
     dispatch("enabled(int tr, double t, const double *x, const double *p)", "int",
              "enabled_{}(t, x, p)", [tr.name for tr in order], "tr")
     dispatch("reset(int tr, double t, const double *x, const double *p, double *xout, int *target)", "int",

@@ -73,6 +73,7 @@ class Kernels:
         lib.amble_info(info.ctypes.data_as(_i64ptr))
         self.n_modes, self.nx_max, self.n_tr, self.n_points = (int(v) for v in info[:4])
         self.layout = int(info[6])
+        self.sc = int(info[7])  # columns of a sensitivity row (state, then parameters)
         if self.layout != abi.LAYOUT:
             raise CompileError(
                 f"compiled model {so} has interface layout {self.layout}, this amble expects {abi.LAYOUT}: "
@@ -81,7 +82,7 @@ class Kernels:
         lib.amble_simulate.restype = ctypes.c_int
         # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
         # evaluation, and building typed ctypes pointers costs more than a walking step.
-        lib.amble_simulate.argtypes = [ctypes.c_void_p] * 13
+        lib.amble_simulate.argtypes = [ctypes.c_void_p] * 14
         lib.amble_rhs.restype = ctypes.c_int
         lib.amble_rhs.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         lib.amble_guards.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
@@ -90,6 +91,13 @@ class Kernels:
         lib.amble_dynamics.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr, _dptr]
         lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
+        lib.amble_rhs_jac.restype = ctypes.c_int
+        lib.amble_rhs_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr]
+        lib.amble_rhs_jacp.restype = ctypes.c_int
+        lib.amble_rhs_jacp.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
+        lib.amble_surfaces_grad.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
+        lib.amble_reset_jac.restype = ctypes.c_int
+        lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         self.simulate_raw = lib.amble_simulate
 
     # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
@@ -142,6 +150,50 @@ class Kernels:
             raise ModelError(f"reset of {trs[k]['name']!r} failed (singular impulse system)")
         mode = self.meta["modes"][target.value]
         return mode, out[: self.meta["nx"][target.value]].copy()
+
+    # -- exact derivatives (generated from the symbolic model; see derivation/variational.py)
+    def rhs_jacobian(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
+        mi = self.mode_index(mode)
+        nx = self.meta["nx"][mi]
+        x = _vec(x, nx)
+        dx, J = np.zeros(nx), np.zeros((nx, self.sc))
+        err = self._lib.amble_rhs_jac(mi, float(t), _p(x), _p(p), _p(dx), _p(J))
+        err = err or self._lib.amble_rhs_jacp(mi, float(t), _p(x), _p(p), _p(J))
+        if err:
+            raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
+        npar = len(self.meta["params"])
+        return dx, J[:, :nx].copy(), J[:, self.nx_max : self.nx_max + npar].copy()
+
+    def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray]:
+        """``(∂g/∂x, ∂g/∂p)`` of a mode's guards (one row per transition from it, in order), then
+        its switching surfaces."""
+        mi = self.mode_index(mode)
+        nx = self.meta["nx"][mi]
+        x = _vec(x, nx)
+        G = np.zeros((max(self.n_tr, 1) + len(self.meta["switches"]), self.sc))
+        self._lib.amble_surfaces_grad(mi, float(t), _p(x), _p(p), _p(G))
+        rows = sum(1 for tr in self.meta["transitions"] if tr["source"] == self.meta["modes"][mi])
+        rows += sum(1 for sw in self.meta["switches"] if sw["mode"] == self.meta["modes"][mi])
+        npar = len(self.meta["params"])
+        return G[:rows, :nx].copy(), G[:rows, self.nx_max : self.nx_max + npar].copy()
+
+    def reset_jacobian(self, transition: int, t: float, x: np.ndarray, p: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
+        trs = self.meta["transitions"]
+        src = self.meta["modes"].index(trs[transition]["source"])
+        dst = self.meta["modes"].index(trs[transition]["target"]) if trs[transition]["target"] else src
+        nx, nd = self.meta["nx"][src], self.meta["nx"][dst]
+        x = _vec(x, nx)
+        D = np.zeros((self.nx_max, self.sc + 1))
+        err = self._lib.amble_reset_jac(transition, float(t), _p(x), _p(p), _p(D))
+        if err:
+            raise ModelError(f"reset of {trs[transition]['name']!r} failed (singular impulse system)")
+        npar = len(self.meta["params"])
+        return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + npar].copy(), D[:nd, self.sc].copy()
 
     def energy_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         t, modes, x = _rows(t, modes, x, self.nx_max, self.n_modes)

@@ -18,7 +18,7 @@ from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError
-from ..simulation.engine import Options
+from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .equations import cmd_equations
 from .output import write_output
@@ -94,7 +94,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
     # samples are recorded only for an output that shows them: a summary needs the events alone
     tr = simulate(s, x0, params=params, steps=steps, t_end=args.time, rtol=args.rtol, atol=args.atol,
-                  sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p))
+                  sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
     if out_p:
         write_output(out_p, tr.save, "--out")
@@ -159,9 +159,18 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
             _animate(tr, anim_p)
             out["animation"] = str(anim_p)
     if not args.json:
+        unit = s.time_unit
+        if lc.requested_period and lc.requested_period != lc.period:
+            print(f"{args.model}: the period-{lc.requested_period} search converged to a period-{lc.period} gait")
         print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
-              f"step time {lc.step_time:.6g} s (residual {lc.residual:.1e}, {lc.iterations} iterations)")
-        print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
+              f"{'mean ' if lc.period > 1 else ''}step time {lc.step_time:.6g} {unit} "
+              f"(residual {lc.residual:.1e}, {lc.iterations} iterations)")
+        if lc.period == 1:
+            print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
+        else:  # every point of the orbit and the time of every step: the mean alone hides the alternation
+            for i, (point, dt) in enumerate(zip(lc.orbit, lc.step_times), 1):
+                print(f"point {i}/{lc.period} (step time {dt:.6g} {unit}): "
+                      + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, point)))
         print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
         for k in ("plot", "animation"):
             if k in out:
@@ -224,26 +233,33 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
+    s.add_argument("--method", choices=METHODS, default="dop853",
+                   help="integrator: dop853 (explicit, default) or radau (implicit, for stiff models)")
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)
-    lc.add_argument("--period", type=int, default=1, help="k for a period-k gait (default 1)")
+    lc.add_argument("--period", type=int, default=1,
+                    help="k for a period-k gait (default 1); all k points and step times are reported")
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.set_defaults(func=cmd_limit_cycle)
-    sw = add("sweep", "parameter sweep (fixed points, bifurcation diagram) or basin of attraction, on Dask")
+    sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
+                      "on Dask")
     model_args(sw, None)
-    sw.add_argument("--kind", choices=("fixed-point", "bifurcation", "basin"), default="fixed-point",
-                    help="continuation of the fixed point (default), post-transient iterates (bifurcation), "
-                         "or which initial post-impact states walk into the gait (basin)")
+    sw.add_argument("--kind", choices=("fixed-point", "continuation", "bifurcation", "basin"), default="fixed-point",
+                    help="the fixed point on a grid of parameter values (default), pseudo-arclength "
+                         "continuation with folds, period doublings and the period-doubled branches "
+                         "(continuation), post-transient iterates (bifurcation), or which initial "
+                         "post-impact states walk into the gait (basin)")
     sw.add_argument("--param", action="append", metavar="NAME=START:STOP:COUNT",
                     help="swept parameter: give one for a branch or bifurcation diagram, two for a 2D map "
-                         "(fixed-point and bifurcation kinds)")
+                         "(fixed-point and bifurcation kinds); --kind continuation: NAME=START:STOP[:STEPS], "
+                         "STEPS (default 50) bounding the parameter change per step by |STOP-START|/STEPS")
     sw.add_argument("--x", action="append", metavar="NAME=START:STOP:COUNT",
                     help="--kind basin: a coordinate of the initial post-impact state, give exactly two "
                          "(e.g. --x stance=-0.4:0:100 --x stance_dot=0.5:1.6:100); the other coordinates "
-                         "come from the fixed point (compass-like walkers: swing = 2*slope - stance)")
+                         "come from the fixed point, the dependent ones from the post-impact section")
     sw.add_argument("--steps", type=int, default=None,
                     help=f"--kind basin: footfalls walked from each initial state at most (default {BASIN_STEPS})")
     sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")

@@ -2,6 +2,7 @@
 
 Turns the parsed options into one call of :func:`~amble.analysis.fixed_points.sweep_fixed_points`,
 :func:`~amble.analysis.fixed_points.sweep_fixed_points_2d`,
+:func:`~amble.analysis.continuation_sweep.sweep_continuation`,
 :func:`~amble.analysis.bifurcation.bifurcation` or :func:`~amble.analysis.basin.basin`, prints a
 short report (or returns it for ``--json``) and draws the plot. Bad input raises
 :class:`amble.cli.UsageError` (exit code 2) before any work starts.
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..analysis.basin import BASIN_LABELS, BasinResult, basin
 from ..analysis.bifurcation import bifurcation, first_period_doubling_iterates
+from ..analysis.continuation_sweep import bifurcation_rows, sweep_continuation
 from ..analysis.defaults import BASIN_STEPS
 from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from ..simulation.engine import Options
@@ -73,6 +75,7 @@ def sweep_cli(args: Any) -> dict[str, Any]:
         from ..viz import sweep_plots as sp
 
         draw = (sp.plot_basin if basin_kind else sp.plot_bifurcation if args.kind == "bifurcation"
+                else sp.plot_continuation if args.kind == "continuation"
                 else sp.plot_branch if len(names) == 1 else sp.plot_parameter_map)
         write_output(plot, lambda part: draw(res, part), "--plot")
         summary["plot"] = str(plot)
@@ -108,15 +111,30 @@ def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tup
         raise usage("--x and --steps apply to --kind basin only")
     if not params:
         raise usage(f"--kind {args.kind} needs --param NAME=START:STOP:COUNT (once, or twice for a 2D map)")
-    ranges = [parse_range(t) for t in params]
+    ranges = [_continuation_range(t, usage) if args.kind == "continuation" else parse_range(t) for t in params]
     if len(ranges) not in (1, 2):
         raise usage(f"--param: give one (branch) or two (map) parameters, got {len(ranges)}")
-    if args.kind == "bifurcation" and len(ranges) != 1:
-        raise usage("--kind bifurcation sweeps exactly one --param")
+    if args.kind in ("bifurcation", "continuation") and len(ranges) != 1:
+        raise usage(f"--kind {args.kind} sweeps exactly one --param")
     if len(ranges) == 2 and ranges[0][0] == ranges[1][0]:
         raise usage(f"--param: the two parameters must differ, got {ranges[0][0]!r} twice")
     check_grid_size([r[3] for r in ranges], "--param")
     return ranges
+
+
+def _continuation_range(text: str, usage: type[Exception]) -> tuple[str, float, float, int]:
+    """``NAME=START:STOP[:STEPS]`` of ``--kind continuation``: STOP may lie below START (the branch
+    is followed downwards); STEPS (default 50) bounds the parameter change per step by
+    |STOP − START| / STEPS."""
+    name, eq, rng = text.partition("=")
+    parts = rng.split(":")
+    if not eq or len(parts) not in (2, 3):
+        raise usage(f"--kind continuation expects --param NAME=START:STOP[:STEPS], got {text!r}")
+    name, a, b, n = parse_range(f"{name}=0:1:{parts[2] if len(parts) == 3 else 50}")
+    start, stop = (parse_range(f"{name}={v}:{v}:1")[1] for v in parts[:2])
+    if start == stop:
+        raise usage(f"--kind continuation needs START ≠ STOP, got {start}:{stop}")
+    return name, start, stop, n
 
 
 def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], args: Any, common: dict[str, Any],
@@ -124,7 +142,17 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
     """Fixed-point branch, 2D map or bifurcation diagram; fills ``summary``, returns the result."""
     names = [r[0] for r in ranges]
     vals = [np.linspace(r[1], r[2], r[3]) for r in ranges]
-    if args.kind == "bifurcation":
+    if args.kind == "continuation":
+        kw = {k: v for k, v in common.items() if k not in ("scheduler", "workers")}  # sequential: this process
+        res = sweep_continuation(system, names[0], ranges[0][1], ranges[0][2], steps=ranges[0][3], **kw)
+        summary["bifurcations"] = bifurcation_rows(res)
+        pts = [r for r in res.rows if r["row"] == "point" and r["status"] == "ok"]
+        summary["branches"] = [{"branch": b, "period": int(rs[0]["period"]), "points": len(rs),
+                                "range": [float(rs[0][names[0]]), float(rs[-1][names[0]])],
+                                "stable_points": sum(1 for r in rs if r["stable"] == "true"), "end": rs[-1]["reason"]}
+                               for b in sorted({int(r["branch"]) for r in pts})
+                               for rs in [[r for r in pts if int(r["branch"]) == b]]]
+    elif args.kind == "bifurcation":
         res = bifurcation(system, names[0], vals[0], **common)
         summary["first_period_two"] = first_period_doubling_iterates(res)
     elif len(names) == 1:
@@ -175,6 +203,12 @@ def _print(summary: dict[str, Any], out: Any, plot: Any) -> None:
     for key in ("period_doubling", "stable_range", "first_period_two"):
         if key in summary:
             print(f"  {key.replace('_', ' ')}: {summary[key]}")
+    p = summary["parameters"][0] if summary.get("parameters") else ""
+    for b in summary.get("branches", []):
+        print(f"  branch {b['branch']}: period {b['period']}, {p} {b['range'][0]:.6g} → {b['range'][1]:.6g}, "
+              f"{b['points']} points ({b['stable_points']} stable); {b['end']}")
+    for b in summary.get("bifurcations", []):
+        print(f"  {b['kind']} on branch {b['branch']} (period {b['period']}) at {p} = {b[p]:.12g}")
     if out is not None:
         print(f"  results: {out}")
     if plot is not None:

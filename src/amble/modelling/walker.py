@@ -16,6 +16,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
+from .contact import RoundFoot
 from .domain import interval
 from .hybrid import Guard, HybridSystem, Impact, Lock
 from .model import Model
@@ -97,16 +98,27 @@ def model_size(model: Model) -> sp.Expr:
     return sp.sqrt(sum(((p.T * p)[0, 0] for p in pts), sp.Integer(0)) / len(pts))
 
 
-def heel_strike(model: Model, foot: str, slope: Any, relabel: Mapping[Any, Any],
-                margin: Any = None) -> tuple[Guard, Impact]:
+def heel_strike(model: Model, foot: str | RoundFoot, slope: Any, relabel: Mapping[Any, Any],
+                margin: Any = None, stance: str | RoundFoot | None = None) -> tuple[Guard, Impact]:
     """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot
     by more than ``margin`` (default :data:`STEP_MARGIN` × :func:`model_size`, so that legs
     passing each other — the foot at the stance foot up to round-off — are no footfall),
-    followed by a plastic impact and the leg relabelling."""
+    followed by a plastic impact and the leg relabelling.
+
+    ``foot`` is a point (a point foot) or a :class:`~amble.modelling.contact.RoundFoot`: then its
+    contact point meets the slope and the impact constrains the material point of the foot at
+    the contact (its ``rolling`` point, which also becomes the next step's origin). ``stance``
+    names the stance foot's contact (a point or a ``RoundFoot``) that the foot must be ahead
+    of; by default the origin, where a point stance foot stands.
+    """
+    contact = foot.contact if isinstance(foot, RoundFoot) else foot
     if margin is None:
         margin = STEP_MARGIN * model_size(model)
-    guard = Guard(height_above_slope(model, foot, slope), -1, distance_along_slope(model, foot, slope) > margin)
-    return guard, Impact(foot, relabel)
+    ahead = distance_along_slope(model, contact, slope)
+    if stance is not None:
+        ahead -= distance_along_slope(model, stance.contact if isinstance(stance, RoundFoot) else stance, slope)
+    guard = Guard(height_above_slope(model, contact, slope), -1, ahead > margin)
+    return guard, Impact(foot.rolling if isinstance(foot, RoundFoot) else foot, relabel)
 
 
 def joint_lock(constraint: Any, relabel: Mapping[Any, Any] | None = None) -> tuple[Guard, Lock]:
@@ -119,7 +131,7 @@ def joint_lock(constraint: Any, relabel: Mapping[Any, Any] | None = None) -> tup
 def walker(
     model: Model,
     *,
-    foot: str,
+    foot: str | RoundFoot,
     hip: str,
     slope: Any,
     relabel: Mapping[Any, Any],
@@ -129,17 +141,19 @@ def walker(
     mirror: str | None = None,
     doc: str = "",
     margin: Any = None,
+    stance: str | RoundFoot | None = None,
 ) -> Walker:
     """A one-mode walker: heel strike of ``foot`` on the slope (a step) and a fall of ``hip``.
 
     ``start`` is the default initial state, ``guess`` the default fixed-point guess (both in
     ``model.state_names`` order). A walker that makes no footfall for ``max_step_time`` seconds,
     or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`; ``margin``:
-    the footfall's enabling margin, see :func:`heel_strike`.
+    the footfall's enabling margin, and ``stance`` the stance foot the swing ``foot`` must be ahead
+    of (needed with round feet, whose stance contact moves), see :func:`heel_strike`.
     """
     sys_ = Walker(model.name, {model.name: model}, max_step_time=max_step_time, hip=hip, slope=slope,
                   mirror=mirror, doc=doc)
-    guard, reset = heel_strike(model, foot, slope, relabel, margin)
+    guard, reset = heel_strike(model, foot, slope, relabel, margin, stance)
     sys_.transition("heel_strike", model.name, guard, reset, step=True)
     sys_.terminal("hip_on_ground", model.name, Guard(height_above_slope(model, hip, slope), -1), status="fell")
     if start is not None:

@@ -40,6 +40,11 @@ Stable gait at the defaults (post-impact): x* = (−0.22244, 0.32244, 0.32244, 1
 and 0.077. The thesis' Eq. 30, x* = (0.075, −0.081, −0.081, −0.26, 0.49, 0.49), has Goswami's
 signs (angles counter-clockwise) at best, and lies on no heel-strike section of a 0.05 rad slope
 (stance + swing would be ∓0.1): it cannot be compared beyond its signs.
+
+At Hsu Chen's parameters the default search (``amble limit-cycle kneed-biped --set ...``) finds her
+stable gait at slopes 0.0503685, 0.0504 and 0.06 (step 0.5646, 0.5646, 0.5754 s): it follows the
+gait above from the defaults when the cycle nearest the guess is unstable (at 0.06: 0.474 s,
+|multipliers| up to 3.60).
 """
 
 from amble import NONNEGATIVE, POSITIVE, Guard, Model, R, Walker, heel_strike, height_above_slope, joint_lock

@@ -22,6 +22,9 @@ from ..errors import StateError
 #: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB.
 RECORD_BUDGET = 512 * 2**20
 
+#: Integrators, in the order of the compiled loop's IO_METHOD codes.
+METHODS = ("dop853", "radau")
+
 #: Accepted integrator steps per compiled call: the loop returns this often so that Python can
 #: handle signals (Ctrl-C), then resumes exactly where it stopped.
 YIELD_STEPS = 20_000
@@ -44,7 +47,10 @@ class Options:
     at both step ends (which already finds a guard dipping through zero and back inside a step).
     max_integrator_steps: cap on accepted integrator steps of a run (status
     ``max_integrator_steps``); max_steps_between_events: cap on accepted steps between two
-    transitions (status ``stalled``: a stiff or chattering run). 0: no cap.
+    transitions (status ``stalled``: a stiff or chattering run). 0: no cap. method: ``"dop853"``
+    (explicit, 8th order: the default) or ``"radau"`` (Radau IIA, implicit, 5th order, with the
+    model's exact Jacobian in its Newton iterations: for stiff runs — high-gain controllers, stiff
+    springs — where an explicit method's step is bounded by stability rather than accuracy).
     """
 
     rtol: float = 1e-10
@@ -57,8 +63,11 @@ class Options:
     nsub: int = 1
     max_integrator_steps: int = 20_000_000
     max_steps_between_events: int = 1_000_000
+    method: str = "dop853"
 
     def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise StateError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
         # a tolerance outside (0, 1) asks for no accuracy or for the impossible (rtol 1e-300 never ends)
         for name in ("rtol", "atol"):
             v = getattr(self, name)
@@ -81,8 +90,27 @@ class Options:
         """``iopt`` laid out by the table, with the per-run fields (steps, capacities) at 0."""
         values = {"MAXSTEPS": 0, "MAXEVENTS": self.max_events, "OUTCAP": 0, "EVCAP": 0, "ZENON": self.zeno_events,
                   "NSUB": self.nsub, "MAXISTEPS": self.max_integrator_steps,
-                  "MAXISTEPS_EV": self.max_steps_between_events, "YIELDN": YIELD_STEPS}
+                  "MAXISTEPS_EV": self.max_steps_between_events, "YIELDN": YIELD_STEPS,
+                  "METHOD": METHODS.index(self.method)}
         return np.array([values[f] for f in IOPT_FIELDS], dtype=np.int64)
+
+
+@dataclass(slots=True)
+class Sensitivity:
+    """Derivatives of where a run ended with respect to its initial state ``x0`` and the
+    parameters ``p`` (in the kernels' parameter order), from the variational equations and the
+    saltation matrices of its events.
+
+    A run that ended at an event (its steps done, a terminal transition, the event cap) ended at
+    a time that moves with the data: ``dx_dx0``/``dx_dp`` are then the derivatives of the state at
+    that event (just after the reset for a step, just before a terminal one), and
+    ``dt_dx0``/``dt_dp`` those of the event time. A run that ended at a fixed time has ``dt = 0``.
+    """
+
+    dx_dx0: np.ndarray
+    dx_dp: np.ndarray
+    dt_dx0: np.ndarray
+    dt_dp: np.ndarray
 
 
 @dataclass(slots=True)
@@ -103,6 +131,7 @@ class Run:
     info: int
     ctx: np.ndarray
     recorded: dict[str, Any]
+    sensitivity: Sensitivity | None = None
 
     @property
     def completed(self) -> bool:
@@ -131,11 +160,14 @@ def run(
     record: bool = False,
     events_only: bool = False,
     budget: int = RECORD_BUDGET,
+    sensitivities: bool | str = False,
 ) -> Run:
     """Run from ``x0`` in mode ``mode`` at ``t0`` until ``t_end`` (s), ``steps`` step transitions
     (0: no limit) or another end; record samples (every ``sample_dt`` s, 0: every integration step)
     and events when ``record`` (only events with ``events_only``). Recorded buffers never grow
-    past ``budget`` bytes: the run then ends as ``record_limit`` with what it recorded."""
+    past ``budget`` bytes: the run then ends as ``record_limit`` with what it recorded. With
+    ``sensitivities`` the run also carries ``∂x/∂(x0, p)`` (:class:`Sensitivity`); ``"state"``
+    carries ``∂x/∂x0`` only (cheaper: parameters touch most of the model's expressions)."""
     # Called once per return-map evaluation (tens of µs of compiled work): the arrays are laid
     # out from templates and index constants, not rebuilt field by field.
     nxm = k.nx_max
@@ -148,11 +180,18 @@ def run(
     iopt = opts._iopt.copy()
     iopt[_IO_MAXSTEPS] = steps
     buf = _Buffers(0 if events_only else 1024, 64, nxm) if record else _NO_RECORDING
+    if sensitivities not in (False, True, "state"):
+        raise StateError(f"sensitivities must be True, False or 'state', got {sensitivities!r}")
+    if sensitivities and opts.method != "dop853":
+        # the variational equations ride on the explicit method's stages
+        raise StateError(f"sensitivities need method='dop853', not {opts.method!r}")
+    sens = _sensitivity_buffer(k, x0.size, sensitivities is True) if sensitivities else None
+    sens_addr = sens.ctypes.data if sens is not None else None
     code = CODE["YIELD"]
     try:
         while True:
             iopt[_IO_OUTCAP], iopt[_IO_EVCAP] = buf.cap, buf.ecap
-            code = buf.call(k, p, ctx, opt, iopt)
+            code = buf.call(k, p, ctx, opt, iopt, sens_addr)
             if code == CODE["BUFFER_FULL"]:
                 if buf.nbytes_grown() > budget:  # the run is resumable here: stop with what it has
                     code = CODE["RECORD_LIMIT"]
@@ -164,7 +203,41 @@ def run(
         # Ctrl-C between two compiled calls: the run so far stays reachable as ``exc.run``
         exc.run = _result(k, CODE["YIELD"], ctx, buf)  # type: ignore[attr-defined]
         raise
-    return _result(k, code, ctx, buf)
+    r = _result(k, code, ctx, buf)
+    if sens is not None:
+        r.sensitivity = _sensitivity(k, r, sens, x0.size, p)
+    return r
+
+
+#: Runs that end at an event, whose end time therefore moves with the initial data.
+_AT_EVENT = (CODE["STEPS_DONE"], CODE["TERMINAL"], CODE["MAX_EVENTS"])
+
+
+def _sensitivity_buffer(k: Kernels, nx0: int, params: bool) -> np.ndarray:
+    """``S = [I 0]`` (the initial state's own columns), ``dτ = 0`` and the numbers of state and
+    parameter columns carried, laid out as sensitivity.h reads it."""
+    sens = np.zeros((k.nx_max + 1) * k.sc + 2)
+    S = sens[: k.nx_max * k.sc].reshape(k.nx_max, k.sc)
+    S[np.arange(nx0), np.arange(nx0)] = 1.0
+    sens[-2], sens[-1] = nx0, len(k.meta["params"]) if params else 0
+    return sens
+
+
+def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) -> Sensitivity:
+    nxm, sc, npar = k.nx_max, k.sc, int(sens[-1])
+    S = sens[: nxm * sc].reshape(nxm, sc)[: r.x.size]
+    tau = sens[nxm * sc : nxm * sc + sc]
+    cols = np.r_[np.arange(nx0), nxm + np.arange(npar)]
+    S, tau = S[:, cols], tau[cols]
+    if r.code in _AT_EVENT:
+        # the buffer holds S at a fixed time just after the event: the state at the (moving)
+        # event itself adds its flow times dτ
+        f = k.rhs(r.mode, r.t, r.x, p)
+        S = S + np.outer(f, tau)
+    else:
+        tau = np.zeros_like(tau)
+    return Sensitivity(dx_dx0=S[:, :nx0].copy(), dx_dp=S[:, nx0:].copy(), dt_dx0=tau[:nx0].copy(),
+                       dt_dp=tau[nx0:].copy())
 
 
 def _result(k: Kernels, code: int, ctx: np.ndarray, buf: _Buffers) -> Run:
@@ -193,9 +266,9 @@ class _Buffers:
         return tuple(a.ctypes.data for a in (self.t, self.mode, self.x, self.n, self.et, self.etr, self.epre,
                                              self.epost, self.ne))
 
-    def call(self, k: Kernels, p, ctx, opt, iopt) -> int:
+    def call(self, k: Kernels, p, ctx, opt, iopt, sens: int | None = None) -> int:
         out = self._addresses if self is _NO_RECORDING else self.addresses()
-        return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *out))
+        return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *out, sens))
 
     def nbytes_grown(self) -> int:
         """Bytes the buffers would hold after :meth:`grow`."""

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.abi import CODE
+from ..backend.abi import CODE, CTX
 from ..backend.kernels import Kernels, build
 from ..errors import ParameterError, StateError
 from ..modelling.hybrid import HybridSystem
@@ -91,6 +91,7 @@ def simulate(
     options: Options | None = None,
     samples: bool = True,
     budget: int = RECORD_BUDGET,
+    method: str | None = None,
 ) -> Trajectory:
     """Simulate a hybrid system and return its :class:`Trajectory`.
 
@@ -114,6 +115,9 @@ def simulate(
     budget:
         Bytes the recording may take (default 512 MiB); a run that would record more ends as
         ``record_limit`` with what it has.
+    method:
+        ``"dop853"`` (explicit, the default) or ``"radau"`` (implicit Radau IIA with the model's
+        exact Jacobian, for stiff systems); default that of ``options``.
     """
     base = options or Options()
     if not isinstance(base, Options):
@@ -140,7 +144,8 @@ def simulate(
     if steps is None and t_end is None:
         t_end = 10.0
     mst = max_step_time if max_step_time is not None else system.max_step_time
-    opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=mst)
+    opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=mst,
+                               method=base.method if method is None else method)
     try:
         r = run(k, p, mi, x, t_end=t_end if t_end is not None else math.inf, steps=steps or 0, opts=opts,
                 sample_dt=sample_dt, record=True, events_only=not samples, budget=budget)
@@ -214,8 +219,9 @@ _MESSAGES = {
     "MAX_EVENTS": "{events} events, the most allowed, at t = {t:.6g} s",
     "RECORD_LIMIT": "recording budget spent at t = {t:.6g} s ({steps} steps): record less often (sample_dt) "
                     "or nothing (samples=False)",
-    "STALLED": "{max_steps_between_events} integrator steps without a transition, the most allowed, at t = {t:.9g} s",
-    "MAX_ISTEPS": "{max_integrator_steps} integrator steps, the most allowed, at t = {t:.9g} s",
+    "STALLED": "{max_steps_between_events} integrator steps without a transition, the most allowed, at t = {t:.9g} s"
+               "{stiff}",
+    "MAX_ISTEPS": "{max_integrator_steps} integrator steps, the most allowed, at t = {t:.9g} s{stiff}",
     "YIELD": "interrupted at t = {t:.9g} s",
     "SLIDING": "sliding on switching surface {surface} ({surface_expr}) at t = {t:.9g} s",
 }
@@ -229,7 +235,21 @@ def _message(r: Run, opts: Options, trs: list, switches: list) -> str:
                            max_steps_between_events=opts.max_steps_between_events,
                            max_integrator_steps=opts.max_integrator_steps, surface=r.info,
                            surface_expr=_surface(r, switches),
-                           transition=trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "")
+                           transition=trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "",
+                           stiff=_stiff_hint(r, opts))
+
+
+def _stiff_hint(r: Run, opts: Options) -> str:
+    """An explicit run that exhausted its step budget with tiny steps is most likely stiff: its
+    steps are bounded by stability, not accuracy (``ctx`` holds the next step size)."""
+    if opts.method != "dop853":
+        return ""
+    h = float(r.ctx[CTX["H"]])
+    mean = r.t / max(float(r.ctx[CTX["ISTEPS"]]), 1.0)
+    if h > 0 and mean > 0 and h < 1e-4 * max(r.t, 1.0):
+        return (f" (steps of ~{mean:.2g} s: the system looks stiff; try the implicit integrator, "
+                f"method='radau' / --method radau)")
+    return ""
 
 
 def _surface(r: Run, switches: list) -> str:

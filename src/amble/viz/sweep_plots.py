@@ -1,5 +1,6 @@
 """Plots of parameter sweeps (matplotlib, Agg backend): bifurcation diagram, fixed-point branch
-with multiplier moduli, two-parameter stability map, basin of attraction, Poincaré iterates.
+with multiplier moduli, continued branches with their bifurcations, two-parameter stability map,
+basin of attraction, Poincaré iterates.
 
 Every function writes one figure to ``path`` (format from the suffix: .png, .svg or .pdf) and
 returns the path. Angles are in rad, angular velocities in rad/s; a swept parameter's unit is
@@ -149,6 +150,61 @@ def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | Non
     return _save(fig, path)
 
 
+def plot_continuation(result: Any, path: str | os.PathLike, *, coordinate: str | None = None,
+                      title: str | None = None) -> Path:
+    """Continued branches: top, one coordinate (default the first) of every post-impact state of
+    each gait's orbit vs the parameter — a period-k branch draws k curves — solid where the gait
+    is stable, dotted where not, folds (▲) and flips (●) marked; bottom, the largest multiplier
+    modulus of each branch (log scale, |μ| = 1 dashed)."""
+    plt = _plt()
+    pname = result.params[0]
+    names = list(result.state_names)
+    coord = coordinate or (names[0] if names else None)
+    ci = names.index(coord) if coord in names else 0
+    ok = [r for r in result.rows if r["status"] == "ok"]
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for b in sorted({int(r["branch"]) for r in ok}):
+        pts = [r for r in ok if int(r["branch"]) == b and r["row"] == "point"]
+        if not pts:
+            continue
+        col = colours[b % len(colours)]
+        v = np.array([float(r[pname]) for r in pts])
+        orbit = [np.asarray(json.loads(r["orbit"]))[:, ci] for r in pts]
+        stable = np.array([r["stable"] == "true" for r in pts])
+        mod = np.array([float(r["max_modulus"]) for r in pts])
+        k = min(len(o) for o in orbit)
+        # each style's mask takes one neighbour more, so the curve has no gap where stability changes
+        grow = np.convolve(~stable, [1, 1, 1], "same") > 0
+        for j in range(k):
+            y = np.array([o[j] for o in orbit])
+            for mask, ls in ((stable, "-"), (grow, ":")):
+                a1.plot(v, np.where(mask, y, np.nan), ls, color=col, lw=1.6,
+                        label=(f"period {pts[0]['period']}" + ("" if ls == "-" else ", unstable"))
+                        if j == 0 and mask.any() else None)
+        a2.plot(v, mod, "-", color=col, lw=1.4)
+        for r in ok:
+            if int(r["branch"]) == b and r["row"] in ("fold", "flip"):
+                o = np.asarray(json.loads(r["orbit"]))[:, ci]
+                a1.plot([float(r[pname])] * len(o), o, "^" if r["row"] == "fold" else "o", color="k", ms=5)
+                a2.axvline(float(r[pname]), color="0.6", lw=0.8)
+    kinds = {r["row"] for r in ok}
+    if "flip" in kinds:
+        a1.plot([], [], "o", color="k", ms=5, label="period doubling (flip, μ = −1)")
+    if "fold" in kinds:
+        a1.plot([], [], "^", color="k", ms=5, label="fold (μ = +1)")
+    a2.axhline(1.0, ls="--", color="k", lw=1)
+    a2.set_yscale("log")
+    a1.set_ylabel(f"post-impact {_label(coord)}" if coord else "post-impact state")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    a2.set_ylabel("largest |μ| (1)")
+    a2.set_xlabel(_label(pname))
+    a2.grid(alpha=0.3, which="both")
+    a1.set_title(title or "Continuation: branches of gaits, stability and bifurcations")
+    return _save(fig, path)
+
+
 BASIN_COLOURS = ("#2a9d8f", "#e76f51", "#e9c46a", "#6c757d")
 
 
@@ -207,4 +263,4 @@ def plot_poincare(iterates: np.ndarray, path: str | os.PathLike, *, state_names:
     return _save(fig, path)
 
 
-__all__ = ["plot_basin", "plot_bifurcation", "plot_branch", "plot_parameter_map", "plot_poincare"]
+__all__ = ["plot_basin", "plot_bifurcation", "plot_branch", "plot_continuation", "plot_parameter_map", "plot_poincare"]

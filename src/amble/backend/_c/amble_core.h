@@ -108,4 +108,131 @@ static int amble_impulse(int ne, int nc, const double *Me, const double *J, doub
     return 0;
 }
 
+/* ---- solves for sensitivity runs: one factorisation, many right-hand sides ---- */
+
+/* Cholesky factor of a symmetric positive definite A (row-major, lower triangle read and
+ * overwritten by L). Same acceptance test as amble_chol_solve. */
+static int amble_chol_factor(int n, double *A) {
+    double dmin = INFINITY, dmax = 0.0;
+    for (int j = 0; j < n; ++j) {
+        double s = A[j * n + j];
+        for (int k = 0; k < j; ++k) s -= A[j * n + k] * A[j * n + k];
+        if (!(s > 0.0)) return AMBLE_ERR_SINGULAR_MASS;
+        double d = sqrt(s);
+        A[j * n + j] = d;
+        if (d < dmin) dmin = d;
+        if (d > dmax) dmax = d;
+        for (int i = j + 1; i < n; ++i) {
+            double v = A[i * n + j];
+            for (int k = 0; k < j; ++k) v -= A[i * n + k] * A[j * n + k];
+            A[i * n + j] = v / d;
+        }
+    }
+    return dmax > 1e7 * dmin ? AMBLE_ERR_SINGULAR_MASS : 0;
+}
+
+/* Solve L Lᵀ X = B in place for the ncols columns of B (row-major n × ncols). */
+static void amble_chol_apply(int n, const double *L, double *B, int ncols) {
+    for (int c = 0; c < ncols; ++c) {
+        for (int i = 0; i < n; ++i) {
+            double v = B[i * ncols + c];
+            for (int k = 0; k < i; ++k) v -= L[i * n + k] * B[k * ncols + c];
+            B[i * ncols + c] = v / L[i * n + i];
+        }
+        for (int i = n - 1; i >= 0; --i) {
+            double v = B[i * ncols + c];
+            for (int k = i + 1; k < n; ++k) v -= L[k * n + i] * B[k * ncols + c];
+            B[i * ncols + c] = v / L[i * n + i];
+        }
+    }
+}
+
+/* LU factorisation with partial pivoting in place (piv: row swaps); AMBLE_ERR_SINGULAR_RESET on a
+ * (near) zero pivot, with the threshold of amble_lu_solve. */
+static int amble_lu_factor(int n, double *A, int *piv) {
+    double scale = 0.0;
+    for (int i = 0; i < n * n; ++i) scale = fmax(scale, fabs(A[i]));
+    if (!(scale > 0.0)) return AMBLE_ERR_SINGULAR_RESET;
+    for (int k = 0; k < n; ++k) {
+        int pk = k;
+        double best = fabs(A[k * n + k]);
+        for (int i = k + 1; i < n; ++i)
+            if (fabs(A[i * n + k]) > best) { best = fabs(A[i * n + k]); pk = i; }
+        if (!(best > 1e-13 * scale)) return AMBLE_ERR_SINGULAR_RESET;
+        piv[k] = pk;
+        if (pk != k)
+            for (int j = 0; j < n; ++j) { double tmp = A[k * n + j]; A[k * n + j] = A[pk * n + j]; A[pk * n + j] = tmp; }
+        for (int i = k + 1; i < n; ++i) {
+            double f = A[i * n + k] / A[k * n + k];
+            A[i * n + k] = f;
+            if (f == 0.0) continue;
+            for (int j = k + 1; j < n; ++j) A[i * n + j] -= f * A[k * n + j];
+        }
+    }
+    return 0;
+}
+
+/* Solve with the factors of amble_lu_factor for the ncols columns of B (row-major n × ncols). */
+static void amble_lu_apply(int n, const double *LU, const int *piv, double *B, int ncols) {
+    for (int c = 0; c < ncols; ++c) {
+        for (int k = 0; k < n; ++k)
+            if (piv[k] != k) { double tmp = B[k * ncols + c]; B[k * ncols + c] = B[piv[k] * ncols + c]; B[piv[k] * ncols + c] = tmp; }
+        for (int i = 1; i < n; ++i) {
+            double v = B[i * ncols + c];
+            for (int k = 0; k < i; ++k) v -= LU[i * n + k] * B[k * ncols + c];
+            B[i * ncols + c] = v;
+        }
+        for (int i = n - 1; i >= 0; --i) {
+            double v = B[i * ncols + c];
+            for (int k = i + 1; k < n; ++k) v -= LU[i * n + k] * B[k * ncols + c];
+            B[i * ncols + c] = v / LU[i * n + i];
+        }
+    }
+}
+
+/* The KKT matrix [[Me, −Jᵀ], [J, 0]] of an impulsive reset, row-major (ne + nc)². */
+static void amble_kkt_matrix(int ne, int nc, const double *Me, const double *J, double *A) {
+    const int nk = ne + nc;
+    memset(A, 0, sizeof(double) * nk * nk);
+    for (int i = 0; i < ne; ++i)
+        for (int j = 0; j < ne; ++j) A[i * nk + j] = Me[i * ne + j];
+    for (int c = 0; c < nc; ++c)
+        for (int j = 0; j < ne; ++j) {
+            A[(ne + c) * nk + j] = J[c * ne + j];
+            A[j * nk + ne + c] = -J[c * ne + j];
+        }
+}
+
+/* amble_impulse that also returns the impulse λ (nc). */
+static int amble_impulse_lambda(int ne, int nc, const double *Me, const double *J, double *v, double *lam) {
+    const int nk = ne + nc;
+    double A[nk * nk], r[nk];
+    int piv[nk];
+    amble_kkt_matrix(ne, nc, Me, J, A);
+    for (int i = 0; i < ne; ++i) {
+        double s = 0.0;
+        for (int j = 0; j < ne; ++j) s += Me[i * ne + j] * v[j];
+        r[i] = s;
+    }
+    for (int c = 0; c < nc; ++c) r[ne + c] = 0.0;
+    int err = amble_lu_factor(nk, A, piv);
+    if (err) return err;
+    amble_lu_apply(nk, A, piv, r, 1);
+    for (int i = 0; i < ne; ++i) v[i] = r[i];
+    for (int c = 0; c < nc; ++c) lam[c] = r[ne + c];
+    return 0;
+}
+
+/* Solve the KKT system for the ncols columns of B ((ne + nc) × ncols, row-major), in place. */
+static int amble_kkt_solve_columns(int ne, int nc, const double *Me, const double *J, double *B, int ncols) {
+    const int nk = ne + nc;
+    double A[nk * nk];
+    int piv[nk];
+    amble_kkt_matrix(ne, nc, Me, J, A);
+    int err = amble_lu_factor(nk, A, piv);
+    if (err) return err;
+    amble_lu_apply(nk, A, piv, B, ncols);
+    return 0;
+}
+
 #endif

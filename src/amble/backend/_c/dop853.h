@@ -16,6 +16,10 @@ typedef struct {
     double K[DOP_STAGES_EXT][NXMAX];
     double F[DOP_INTERP][NXMAX];
     int dense_ready;
+    /* set by an implicit (Radau IIA) step: its dense output is the collocation cubic
+     * y_old + Q0 θ + Q1 θ² + Q2 θ³ (θ = (t − t_old)/h), always ready */
+    int radau;
+    double Q[3][NXMAX];
 } Dop;
 
 static int all_finite(int n, const double *x) {
@@ -128,7 +132,7 @@ static int dop_step(Dop *s, int mode, const double *p, double t_bound, double rt
 
 /* 7th-order continuous extension of the last step (three extra stages). */
 static int dop_dense_prepare(Dop *s, int mode, const double *p) {
-    if (s->dense_ready) return 0;
+    if (s->dense_ready || s->radau) return 0;
     const int n = s->n;
     const double h = s->h;
     double ytmp[NXMAX];
@@ -159,6 +163,10 @@ static int dop_dense_prepare(Dop *s, int mode, const double *p) {
 static void dop_dense_eval(const Dop *s, double t, double *out) {
     const int n = s->n;
     double x = (t - s->t_old) / s->h;
+    if (s->radau) {
+        for (int i = 0; i < n; ++i) out[i] = s->y_old[i] + x * (s->Q[0][i] + x * (s->Q[1][i] + x * s->Q[2][i]));
+        return;
+    }
     for (int i = 0; i < n; ++i) {
         double y = 0.0;
         for (int k = DOP_INTERP - 1, c = 0; k >= 0; --k, ++c) {

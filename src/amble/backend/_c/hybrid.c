@@ -1,6 +1,7 @@
 /* Hybrid simulation loop: integrate a mode, find the step's event, record, reset or end — all
  * in compiled code, one call per simulation. The pieces live in their own headers:
  *   dop853.h  the integrator (steps, dense output, Hermite interpolant)
+ *   radau.h   the implicit integrator for stiff runs (IO_METHOD = 1), same dense-output contract
  *   events.h  guard screening and crossing location inside a step
  *   record.h  sample and event rows in caller-owned buffers
  *
@@ -25,16 +26,19 @@
 
 #include "dop853.h"
 #include "events.h"
+#include "radau.h"
 #include "record.h"
+#include "sensitivity.h"
 
 /* Simulate from the state in ctx until an end condition; see the CX_, OP_, IO_ layouts.
  * Returns a status ST_*; ST_BUFFER_FULL means "grow the buffers and call again", ST_YIELD (every
  * IO_YIELDN accepted steps) "call again" — the caller handles signals in between, the run resumes
  * exactly where it stopped. IO_MAXISTEPS and IO_MAXISTEPS_EV cap the accepted steps of the run and
- * between transitions (0: no cap). */
+ * between transitions (0: no cap). sens: NULL, or the sensitivity buffer of sensitivity.h, carried
+ * along with the state. */
 int amble_simulate(const double *p, double *ctx, const double *opt, const int64_t *iopt,
                    double *out_t, int *out_mode, double *out_x, int64_t *n_out,
-                   double *ev_t, int *ev_tr, double *ev_xpre, double *ev_xpost, int64_t *n_ev) {
+                   double *ev_t, int *ev_tr, double *ev_xpre, double *ev_xpost, int64_t *n_ev, double *sens) {
     Rec rec = {out_t, out_x, ev_t, ev_xpre, ev_xpost, out_mode, ev_tr, n_out, n_ev, iopt[IO_OUTCAP], iopt[IO_EVCAP]};
     const int recording = rec.out_cap > 0, ev_recording = rec.ev_cap > 0;
     const double t_end = opt[OP_TEND], rtol = opt[OP_RTOL], atol = opt[OP_ATOL];
@@ -48,6 +52,10 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     if (nsub > NSUB_MAX) nsub = NSUB_MAX;
 
     Dop s;
+    s.radau = 0;
+    const int implicit = iopt[IO_METHOD] == 1;
+    Radau rad;
+    radau_reset(&rad);
     int mode = (int)ctx[CX_MODE];
     if (mode < 0 || mode >= NMODES) return ST_RESET_FAILED;
     s.n = MODE_NX[mode];
@@ -85,7 +93,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (max_step_time > 0.0 && ctx[CX_TLAST_STEP] + max_step_time < t_bound) t_bound = ctx[CX_TLAST_STEP] + max_step_time;
         s.t_old = t;
         double h_try = h_abs;
-        int st = dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try);
+        int st = implicit ? radau_step(&s, &rad, mode, p, t_bound, rtol, atol, max_step, &h_try)
+                          : dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try);
         if (st) { status = st; break; }
         const double t_new = t + s.h;
         const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode], nsf = n_surf(mode);
@@ -120,6 +129,10 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         ctx[CX_ISTEPS] += 1;
         ctx[CX_ISTEPS_EV] += 1;
         if (ev_k < 0) {
+            if (sens) {
+                double y1[NXMAX];
+                if ((st = sens_advance(mode, p, sens_cols(sens), t, s.h, s.y_old, sens, y1))) { status = st; break; }
+            }
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }
             for (int k = 0; k < nsf; ++k) { g_old[k] = g_new[k]; gd_old[k] = gd_new[k]; }
@@ -132,6 +145,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             }
             continue;
         }
+        radau_reset(&rad); /* the flow jumps here: the Newton matrix and the predictor are stale */
         if (ev_k >= ntr) {
             /* --- a switching surface: restart the integrator on its far side, or stop if the flow
              * there points back into it (sliding) --- */
@@ -139,9 +153,12 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             /* crossings accumulating (a switch chattering about a kink) count towards Zeno */
             if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
             ctx[CX_TPREV_EVENT] = t_ev;
+            double fm[NXMAX];
+            if (sens && (st = sens_to_event(&s, mode, p, t, s.y_old, t_ev, x_ev, 1, sens, fm))) { status = st; break; }
             t = t_ev;
             for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
             if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
+            if (sens && (st = sens_jump(mode, ev_k, -1, mode, t_ev, x_ev, p, fm, s.f_old, 0, sens))) { status = st; break; }
             surfaces(mode, t, s.y_old, p, g_old);
             surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
             if (slides_after_crossing(mode, ev_k, t, s.y_old, p, s.n, g_old[ev_k], gd_old[ev_k], from)) {
@@ -166,6 +183,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         /* --- an event: record, then terminate or reset --- */
         const int tr = tr0 + ev_k;
         if (recording) put_row(&rec, t_ev, mode, s.n, x_ev);
+        double fm[NXMAX];
+        if (sens && (st = sens_to_event(&s, mode, p, t, s.y_old, t_ev, x_ev, 0, sens, fm))) { status = st; break; }
         double xpost[NXMAX];
         int target = mode;
         if (TR_TERMINAL[tr]) {
@@ -184,6 +203,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         ctx[CX_EVENTS] += 1;
         ctx[CX_ISTEPS_EV] = 0;
         if (TR_TERMINAL[tr]) {
+            if (sens) sens_jump(mode, ev_k, tr, mode, t_ev, x_ev, p, fm, fm, 1, sens);
             t = t_ev;
             for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
             ctx[CX_INFO] = tr;
@@ -193,6 +213,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
         ctx[CX_TPREV_EVENT] = t_ev;
         const int fired = target == mode ? ev_k : -1;
+        const int source = mode;
         mode = target;
         s.n = MODE_NX[mode];
         t = t_ev;
@@ -200,6 +221,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (recording) put_row(&rec, t, mode, s.n, s.y_old);
         if (TR_STEP[tr]) { ctx[CX_STEPS] += 1; ctx[CX_TLAST_STEP] = t_ev; }
         if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
+        if (sens && (st = sens_jump(source, ev_k, tr, mode, t_ev, x_ev, p, fm, s.f_old, 0, sens))) { status = st; break; }
         surfaces(mode, t, s.y_old, p, g_old);
         surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
         arm_zero_guards(mode, t, s.y_old, s.f_old, p, s.n, g_old, gd_old, fired);
@@ -232,6 +254,22 @@ int amble_reset(int tr, double t, const double *x, const double *p, double *xout
     return reset(tr, t, x, p, xout, target);
 }
 
+int amble_rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J) {
+    return rhs_jac(mode, t, x, p, dx, J);
+}
+
+int amble_rhs_jacp(int mode, double t, const double *x, const double *p, double *J) {
+    return rhs_jacp(mode, t, x, p, J);
+}
+
+void amble_surfaces_grad(int mode, double t, const double *x, const double *p, double *G) {
+    surfaces_grad(mode, t, x, p, G);
+}
+
+int amble_reset_jac(int tr, double t, const double *x, const double *p, double *D) {
+    return reset_jac(tr, t, x, p, D);
+}
+
 void amble_dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G) {
     dynamics(mode, t, x, p, M, h, G);
 }
@@ -254,4 +292,5 @@ void amble_info(int64_t *out) {
     out[4] = NPARAM;
     out[5] = CX_X;
     out[6] = AMBLE_LAYOUT;
+    out[7] = SC;
 }
