@@ -20,7 +20,7 @@ from pathlib import Path
 
 from benchmarks.common import REPO_ROOT, Section, child_env, machine, table
 
-BENCHES: tuple[str, ...] = ("derive", "walk", "startup", "sweep")
+BENCHES: tuple[str, ...] = ("derive", "walk", "startup", "sweep", "gaitopt")
 
 
 def _sweep(quick: bool) -> Section:

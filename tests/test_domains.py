@@ -33,7 +33,7 @@ def test_a_default_outside_its_domain_is_a_model_error():
 @pytest.mark.parametrize("model, params", [
     ("compass-gait", {"m": -5.0}), ("compass-gait", {"a": -0.5}), ("compass-gait", {"g": 0.0}),
     ("compass-gait", {"g": -9.81}), ("compass-gait", {"slope": 1.5}), ("compass-gait", {"slope": 100.0}),
-    ("rimless-wheel", {"alpha": 4.0}), ("humanoid-3d", {"I_xy": -1.0}), ("kneed-biped", {"It": -0.1}),
+    ("rimless-wheel", {"alpha": 4.0}), ("humanoid-3d-yaw", {"I_xy": -1.0}), ("kneed-biped", {"It": -0.1}),
 ])
 def test_unphysical_values_are_refused(model, params):
     with pytest.raises(ParameterError, match="outside its domain"):

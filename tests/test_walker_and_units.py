@@ -90,9 +90,9 @@ def test_walker_slope_resolves_a_parameter():
 
 
 def test_mirrored_walk_alternates_sides_in_the_world():
-    # humanoid-3d swaps its legs with y → −y: the footholds must alternate sides (a straight walk),
-    # which they do only if the world frame is reflected at every footfall
-    tr = amble.simulate(load("humanoid-3d"), steps=4, sample_dt=0.01)
+    # humanoid-3d-yaw (a pelvis of width w) swaps its legs with y → −y: the footholds must alternate
+    # sides (a straight walk), which they do only if the world frame is reflected at every footfall
+    tr = amble.simulate(load("humanoid-3d-yaw"), steps=4, sample_dt=0.01)
     wp = tr.world_points()["stance_foot"]
     ys = [wp[np.searchsorted(tr.t, e.t, side="right") - 1, 1] for e in tr.step_events]  # post-impact rows
     assert all(abs(ys[i] - ys[i + 2]) < 1e-3 for i in range(len(ys) - 2))

@@ -21,6 +21,7 @@ from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval
 from .modelling.geometry import R3, R, t, vector
 from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
 from .modelling.model import Model
+from .modelling.sampled import sample_and_hold
 from .modelling.walker import Walker, distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
 from .simulation.engine import Options
 from .simulation.simulate import simulate
@@ -33,5 +34,6 @@ __all__ = [
     "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
     "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
     "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
-    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "simulate", "t", "vector", "walker",
+    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate", "t",
+    "vector", "walker",
 ]

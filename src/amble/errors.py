@@ -42,3 +42,8 @@ class OutputError(AmbleError, OSError):
 
 class SchedulerError(AmbleError, ConnectionError):
     """The Dask scheduler or its workers cannot be reached or used."""
+
+
+class SolverError(AmbleError, RuntimeError):
+    """A numerical optimisation did not succeed (infeasible, restoration failed, iteration limit);
+    the message names the reason and the most violated constraint."""

@@ -177,6 +177,10 @@ def _structure_digest(system: HybridSystem) -> str:
         parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]
         parts += [m._k_terms, m._v_terms, m._k_override, m._v_override, m._l_override]
         parts += [m._forces, m.gravity_vector]
+        parts += [[(a.symbol, a.on) for a in m.actuators], [m._laws.get(a.symbol, 0) for a in m.actuators]]
+        parts += [[a.limit for a in m.actuators] if m.saturated else []]
+        vc = m.virtual
+        parts += [[vc.outputs, vc.phase, vc.alpha] if vc is not None else []]
         h.update(dag_srepr(parts).encode())
     for tr in system.transitions:
         h.update(repr((tr.name, tr.source, tr.target, tr.terminal, tr.step)).encode())

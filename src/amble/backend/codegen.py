@@ -80,7 +80,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)]
         ex = [eqM[i, j] for i in range(n) for j in range(i + 1)]
         tg += [f"f[{i}]" for i in range(n)]
-        ex += [eq.Gamma[i] - eqh[i] for i in range(n)]
+        ex += [eq.closed_loop_force[i] - eqh[i] for i in range(n)]
         w(f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n")
         w(f"    double M[{n * n}], f[{n}];\n    (void)t; (void)p;\n")
         w(_block(tg, ex, nm, prelude=prelude))
@@ -90,7 +90,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         # M, h and Γ separately (analysis and display; the integrator uses rhs above)
         tg = [f"M[{i * n + j}]" for i in range(n) for j in range(n)] + [f"h[{i}]" for i in range(n)]
         tg += [f"G[{i}]" for i in range(n)]
-        ex = [eqM[i, j] for i in range(n) for j in range(n)] + list(eqh) + list(eq.Gamma)
+        ex = [eqM[i, j] for i in range(n) for j in range(n)] + list(eqh) + list(eq.closed_loop_force)
         w(f"static void dynamics_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n")
         w("    (void)t; (void)p;\n")
         w(_block(tg, ex, nm, prelude=prelude))
@@ -246,7 +246,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
 def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     """Switching surfaces of a mode's right-hand side (forces, controllers, the mass matrix)."""
     eq, m = mi.equations, mi.model
-    exprs = [*eq.Gamma, *eq.h, *eq.M]
+    exprs = [*eq.closed_loop_force, *eq.h, *eq.M]
     return switching_surfaces(exprs, [*m.q, *m.qd, t])
 
 

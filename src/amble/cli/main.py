@@ -1,9 +1,10 @@
 """The ``amble`` command line: every command is one API call plus input/output.
 
 Exit codes: 0 success, 2 user error (bad model name, parameter, range, path, a full disk...),
-1 internal failure, 130 interrupted, 141 standard output closed by its reader (``| head -1``; quiet,
-as a Unix tool ended by SIGPIPE). Errors are one line on stderr, or ``{"error": ...}`` on stdout
-with ``--json``; warnings are one line on stderr.
+1 internal failure or a solver that did not succeed (``SolverError``), 130 interrupted, 141
+standard output closed by its reader (``| head -1``; quiet, as a Unix tool ended by SIGPIPE).
+Errors are one line on stderr, or ``{"error": ...}`` on stdout with ``--json``; warnings are one
+line on stderr.
 """
 
 from __future__ import annotations
@@ -17,10 +18,11 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
-from ..errors import AmbleError
+from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .equations import cmd_equations
+from .gait import add_parser as add_gait_parser
 from .output import write_output
 
 #: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
@@ -145,6 +147,11 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     guess = _start(s, args.guess, params) if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
     out = lc.to_json()
+    if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
+        from ..analysis.gait_check import check_gait
+
+        # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
+        out["checks"] = check_gait(lc.trajectory()).to_json()
     if plot_p or anim_p:
         from ..simulation.simulate import simulate
 
@@ -172,6 +179,9 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
                 print(f"point {i}/{lc.period} (step time {dt:.6g} {unit}): "
                       + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, point)))
         print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
+        if "checks" in out:
+            failed = [k for k, v in out["checks"].items() if v is False]
+            print("gait checks: " + ("all passed" if not failed else "FAILED " + ", ".join(failed)))
         for k in ("plot", "animation"):
             if k in out:
                 print(f"wrote {out[k]}")
@@ -192,6 +202,7 @@ EXAMPLES = {
     "simulate": "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html",
     "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
     "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
+    "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
 }
 
 
@@ -270,6 +281,12 @@ def build_parser() -> argparse.ArgumentParser:
                          "worker processes)")
     sw.add_argument("--workers", type=int, default=None, help="local Dask worker processes (default: cores)")
     sw.set_defaults(func=cmd_sweep)
+
+    def model_arg(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("model", help=MODEL_HELP)
+        sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+
+    add_gait_parser(add, model_arg)
     return p
 
 
@@ -304,6 +321,11 @@ def _main(argv: list[str]) -> int:
         return 0
     except BrokenPipeError:
         raise  # handled in main()
+    except SolverError as e:  # the numbers did not work out (not a user error): one line, exit 1
+        if want_json:
+            print(json.dumps({"error": str(e), "type": type(e).__name__}))
+        print(f"amble: {e}", file=sys.stderr)
+        return 1
     except AmbleError as e:
         msg = str(e).splitlines()[0] if str(e) else type(e).__name__
         if want_json:

@@ -33,8 +33,8 @@ def write_output(path: Path, write: Callable[[Path], Any], what: str) -> Path:
             raise OutputError(f"{what}: {str(path)!r} was not written")
         os.replace(part, path)
     except OSError as e:
-        if isinstance(e, OutputError):
-            raise
+        if isinstance(e, OutputError):  # the writer's own words, about the target rather than the part
+            raise OutputError(str(e).replace(str(part), str(path))) from None
         reason = e.strerror or (os.strerror(e.errno) if e.errno else "") or str(e) or type(e).__name__
         raise OutputError(f"{what}: cannot write {str(path)!r}: {reason}") from None
     finally:

@@ -14,12 +14,14 @@ polynomially with the number of coordinates (see :meth:`Equations.count_ops`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
+from typing import Any
 
 import sympy as sp
 
 from ..errors import ModelError
 from ..modelling.model import Model, t
+from .hzd import hzd_law
 from .tree import tree_dynamics
 
 
@@ -39,6 +41,19 @@ class Equations:
     #: recursion): ``(definitions, M, h)``, definitions as ``(symbol, expression)`` in order —
     #: code generation prints these instead of searching the expanded ones for common parts
     compact: tuple[list[tuple[sp.Symbol, sp.Expr]], sp.Matrix, sp.Matrix] | None = None
+    #: the input matrix (n × nu; ``∂on_j/∂q`` per column) and the input symbols, in declaration order
+    B: sp.Matrix | None = None
+    inputs: list[sp.Symbol] = field(default_factory=list)
+    #: the closed-loop law of every input (nu × 1, zero where none; ``M`` and ``h`` substituted)
+    u: sp.Matrix | None = None
+
+    @cached_property
+    def closed_loop_force(self) -> sp.Matrix:
+        """``Γ + B u(q, q̇, t)``: the generalized force the compiled right-hand side uses
+        (``Gamma`` stays the passive force)."""
+        if self.B is None or self.B.cols == 0 or self.u is None:
+            return self.Gamma
+        return self.Gamma + self.B * self.u
 
     @property
     def q(self) -> list[sp.Symbol]:
@@ -70,6 +85,15 @@ class Equations:
     def residual(self) -> sp.Matrix:
         """``M q̈ + h − Γ``: the Euler–Lagrange residual d/dt ∂L/∂q̇ − ∂L/∂q − Γ."""
         return self.M * sp.Matrix(self.qdd) + self.h - self.Gamma
+
+    def expanded(self, expr: Any) -> Any:
+        """``expr`` with the named intermediate quantities of ``compact`` substituted (last first),
+        an expression of the state, time and parameters only."""
+        if self.compact is None:
+            return expr
+        for s, e in reversed(self.compact[0]):
+            expr = expr.xreplace({s: e})
+        return expr
 
     def count_ops(self) -> int:
         """Arithmetic operations needed to evaluate M, h and Γ with common subexpressions shared."""
@@ -205,8 +229,20 @@ def derive(model: Model) -> Equations:
         defs = model.tree.defs
         compact = (defs.needed([*Mt, *ht]), M + Mt, h + ht)
         M, h = M + defs.expand(Mt), h + defs.expand(ht)
+    B = model.input_matrix()
+    u = model.control_law
+    if model.derived_placeholders and u.rows:
+        subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
+        u = u.xreplace(subs)
+    if model.virtual is not None:  # the HZD law, as named intermediate quantities after the tree's
+        defs, Mc, hc = compact if compact is not None else ([], M, h)
+        hdefs, u = hzd_law(model, Mc, hc, model.generalized_force, B)
+        if model.saturated:
+            u = sp.Matrix([e if a.limit is None else sp.Max(-a.limit, sp.Min(a.limit, e))
+                           for e, a in zip(u, model.actuators)])
+        compact = ([*defs, *hdefs], Mc, hc)
     return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy,
-                     compact=compact)
+                     compact=compact, B=B, inputs=model.inputs, u=u)
 
 
 def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:

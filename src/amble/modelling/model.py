@@ -7,7 +7,9 @@ A :class:`Model` holds what one writes on paper for a mechanical system in one c
 * named points given as 2D ``(x, z)`` or 3D ``(x, y, z)`` position expressions of ``q``,
   optionally carrying a point mass,
 * extra kinetic / potential energy terms, or ``K`` and ``V`` (or ``L``) given outright,
-* generalized forces Γ(q, q̇, t), including piecewise ones.
+* generalized forces Γ(q, q̇, t), including piecewise ones,
+* actuators (inputs ``u`` acting through ``B``) and their control law — see
+  :mod:`amble.modelling.actuators`.
 
 Conventions: SI units, angles in radians. The world frame has ``x`` forward, ``y`` to the left
 (3D only), ``z`` up; gravity points along ``-z`` unless :meth:`Model.gravity` says otherwise.
@@ -24,15 +26,15 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
+from .actuators import Actuators
 from .dag import dag_diff, free_symbols
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
 from .geometry import t
-from .names import Names
 from .tree import RigidTree
 
 
-class Model(Names):
+class Model(Actuators):
     """A mechanical system in one mode, written as positions, masses and energies.
 
     Parameters
@@ -92,6 +94,18 @@ class Model(Names):
         v = sp.Matrix(expr)
         return v.jacobian(self.q) if self.tree is None else sp.Matrix(
             v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j]))
+
+    def point_jacobian(self, name: str) -> sp.Matrix:
+        """``∂p/∂q`` of a named point (dims × n): its velocity is ``J q̇`` (for control laws)."""
+        if name not in self.points:
+            raise ModelError(f"model {self.name!r}: no point named {name!r}")
+        return self.jacobian(self.points[name])
+
+    def point_velocity(self, name: str) -> sp.Matrix:
+        """Velocity (m/s, world axes) of a named point, an expression of q and q̇."""
+        if name not in self.points:
+            raise ModelError(f"model {self.name!r}: no point named {name!r}")
+        return self.dt(self.points[name])
 
     # ------------------------------------------------------------------ geometry
     def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
@@ -317,6 +331,10 @@ class Model(Names):
         jac = full.jacobian(out.q)
         out._forces = [jac.T * f.subs(vsubs) for f in self._forces]
         out._g, out._g_dir = self._g, self._g_dir
+        if any(e.free_symbols & set(self.derived_placeholders) for e in self._laws.values()):
+            raise ModelError(f"model {self.name!r}: a control law written with dynamics() cannot be carried "
+                             "into a constrained model; declare it on that model")
+        self._copy_actuators(out, subs, vsubs)
         return out
 
     # ------------------------------------------------------------------ helpers

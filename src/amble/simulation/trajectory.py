@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import AmbleError
+from . import inputs as _inputs
 
 if TYPE_CHECKING:
     from ..backend.kernels import Kernels
@@ -92,6 +93,23 @@ class Trajectory:
         """Kinetic and potential energy per row, shape (N, 2), in J."""
         return self.kernels.energy_rows(self.t, self.mode, self.x, self.params)
 
+    def inputs(self) -> dict[str, np.ndarray]:
+        """Input name → value per sample (N·m or N) from the closed-loop law; empty without
+        actuators (see :mod:`amble.simulation.inputs`)."""
+        return _inputs.inputs(self)
+
+    def joint_power(self) -> dict[str, np.ndarray]:
+        """Input name → mechanical power ``u_j ω_j`` per sample (W)."""
+        return _inputs.joint_power(self)
+
+    def work_per_step(self, absolute: bool = False) -> dict[str, np.ndarray]:
+        """Input name → work per step (J; ``absolute``: of ``|P|``)."""
+        return _inputs.work_per_step(self, absolute)
+
+    def cost_of_transport(self) -> float:
+        """Mechanical cost of transport ``Σ∫|P| dt / (m g d)`` of the run."""
+        return _inputs.cost_of_transport(self)
+
     def points(self) -> dict[str, np.ndarray]:
         """Positions of named points per row in the current stance frame, (N, 3) each."""
         pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
@@ -155,10 +173,13 @@ class Trajectory:
             return self.system.time_unit if self.system is not None else "s"
         if name in ("kinetic_energy", "potential_energy"):
             return "J" if self.system is None or self.system.time_unit == "s" else ""
+        if name.startswith("power_") and self.system is not None and name[6:] in _inputs.input_names(self.system):
+            return "W" if self.system.time_unit == "s" else ""
         return self.system.unit(name) if self.system is not None else ""
 
     def table(self) -> dict[str, np.ndarray]:
-        """Columns: ``t``, ``mode``, then every state variable of every mode (NaN where absent)."""
+        """Columns: ``t``, ``mode``, every state variable of every mode (NaN where absent), the
+        energies, then every input ``u`` and its power ``power_<input>`` (W)."""
         cols: dict[str, np.ndarray] = {"t": self.t, "mode": np.array([self.mode_names[m] for m in self.mode])}
         for m in self.mode_names:
             for name in self.state_names(m):
@@ -166,6 +187,10 @@ class Trajectory:
                     cols[name] = self.column(name)
         e = self.energy()
         cols["kinetic_energy"], cols["potential_energy"] = e[:, 0], e[:, 1]
+        if self.system is not None and _inputs.input_names(self.system):
+            u, power = self.inputs(), self.joint_power()
+            cols.update(u)
+            cols.update({f"power_{k}": v for k, v in power.items()})
         return cols
 
     def save(self, path: str | Path) -> Path:

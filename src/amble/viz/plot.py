@@ -23,7 +23,7 @@ def _plt():
 
 
 _QUANTITY = {"rad": "angle", "rad/s": "angular velocity", "m": "position", "m/s": "velocity", "s": "time",
-             "J": "energy"}
+             "J": "energy", "N·m": "torque", "N": "force", "W": "power"}
 
 
 def _label(traj: Trajectory, names: Sequence[str], fallback: str) -> str:
@@ -36,10 +36,12 @@ def _label(traj: Trajectory, names: Sequence[str], fallback: str) -> str:
 
 
 def plot_trajectory(traj: Trajectory, path: str | Path | None = None, variables: Sequence[str] | None = None) -> Any:
-    """Time series of state variables (default: all coordinates) with footfalls marked."""
+    """Time series of state variables (default: all coordinates) with footfalls marked, the
+    energies, and — for a controlled model — the inputs with their declared limits dashed."""
     plt = _plt()
     names = list(variables or [n for n in traj.state_names() if not n.endswith("_dot")])
-    fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    u = traj.inputs() if traj.system is not None else {}
+    fig, axes = plt.subplots(3 if u else 2, 1, figsize=(8, 8 if u else 5.5), sharex=True)
     for n in names:
         axes[0].plot(traj.t, traj.column(n), label=n)
     for e in traj.step_events:
@@ -52,8 +54,17 @@ def plot_trajectory(traj: Trajectory, path: str | Path | None = None, variables:
     axes[1].plot(traj.t, energy[:, 1] - energy[0, 1], label="potential (rel.)")
     axes[1].plot(traj.t, energy.sum(axis=1) - energy[0, 1], label="total (rel.)", color="k", lw=1)
     axes[1].set_ylabel(_label(traj, ["kinetic_energy"], "energy"))
-    axes[1].set_xlabel(_label(traj, ["t"], "time"))
+    axes[-1].set_xlabel(_label(traj, ["t"], "time"))
     axes[1].legend(loc="upper right", fontsize=8)
+    if u:
+        limits = {k: v for m in traj.system.modes.values() for k, v in m.input_limits.items()}
+        for i, (k, v) in enumerate(u.items()):
+            axes[2].plot(traj.t, v, label=k, color=f"C{i}")
+            if limits.get(k) is not None:
+                for sgn in (-1, 1):
+                    axes[2].axhline(sgn * limits[k], color=f"C{i}", ls="--", lw=0.8)
+        axes[2].set_ylabel(_label(traj, list(u), "input"))
+        axes[2].legend(loc="upper right", fontsize=8)
     axes[0].set_title(f"{traj.kernels.meta['name']}: {traj.status}, {traj.steps} steps")
     fig.tight_layout()
     return _finish(fig, path)

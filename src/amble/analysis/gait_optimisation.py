@@ -1,0 +1,384 @@
+"""Gait design by optimisation: one periodic step of a walker by direct collocation.
+
+The unknowns are the states, accelerations and inputs at the ``2N + 1`` Hermite–Simpson points of
+one step (:mod:`amble.analysis.collocation`), the free step time ``T``, and the impact's
+post-impact extended velocity and impulse. The constraints are
+
+* the equations of motion ``M(q) q̈ + h = Γ + B u`` at every point (implicit: no ``M⁻¹``),
+* the collocation defects,
+* the footfall: the guard ``g(x(T)) = 0`` with its enabling condition, then the derived plastic
+  impact ``M_e (q̇e⁺ − q̇e⁻) = Jᵀλ, J q̇e⁺ = 0`` and the relabelling, which must give back the
+  first state (periodicity),
+* the speed ``L/T = V`` or the step length ``L``, ``L`` the impacting foot's distance ahead of the
+  stance foot along the slope,
+* actuator limits ``|u| ≤ limit`` (``Model.input_limits``), joint limits (a tree's joint limits and
+  ``bounds``), unilateral contact ``F_n ≥ 0`` and, with ``mu``, the friction cone ``|F_t| ≤ μ F_n``
+  at the stance foot over the whole step, a non-negative normal impulse at impact (and the old
+  stance foot leaving the ground), and, with ``clearance``, the swing foot at least
+  ``clearance · 4s(1 − s)`` above the ground at phase ``s = t/T``.
+
+Objectives, all per unit distance walked: ``effort`` ``(1/L) ∫ ‖u‖² dt``, ``cot`` (cost of
+transport) ``(1/(mₜ g L)) ∫ Σ |u_j v_j| dt`` with ``v = Bᵀq̇`` (each power split into its positive
+and negative parts, ``u_j v_j = p⁺ − p⁻``, ``p± ≥ 0``, so that ``|u_j v_j| = p⁺ + p⁻`` at the optimum
+without a kink), or a user expression
+``c(q, q̇, u)``: ``(1/L) ∫ c dt``. CasADi builds the problem from amble's derived expressions
+(:mod:`amble.backend.casadi_export`) with exact sparse first and second derivatives; IPOPT solves it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
+from ..errors import ParameterError, SolverError, StateError
+from ..modelling.hybrid import HybridSystem
+from .collocation import defects, simpson_weights
+from .gait_hzd import bezier_start, virtual_constraints
+from .gait_result import Gait, bezier_fit, constraint_report
+from .gait_start import initial_guess
+
+OBJECTIVES = ("effort", "cot")
+
+_FAILURES = {
+    "Infeasible_Problem_Detected": "the constraints are infeasible",
+    "Restoration_Failed": "restoration failed (no feasible point near the iterate)",
+    "Maximum_Iterations_Exceeded": "iteration limit reached",
+    "Maximum_CpuTime_Exceeded": "time limit reached",
+    "Search_Direction_Becomes_Too_Small": "search direction too small",
+    "Error_In_Step_Computation": "error in step computation",
+    "Invalid_Number_Detected": "a non-finite number in the model's functions",
+    "Diverging_Iterates": "diverging iterates",
+}
+
+
+def optimize_gait(
+    system: HybridSystem,
+    *,
+    params: Mapping[str, float] | None = None,
+    speed: float | None = None,
+    step_length: float | None = None,
+    objective: str | sp.Expr = "effort",
+    nodes: int | Sequence[int] = 30,
+    guess: str | Sequence[float] | None = None,
+    step_time: float | None = None,
+    mu: float | None = None,
+    clearance: float | None = None,
+    bounds: Mapping[str, tuple[float | None, float | None]] | None = None,
+    bezier_degree: int = 5,
+    phase: Any = None,
+    max_iter: int = 500,
+    tol: float = 1e-10,
+    hzd: bool = False,
+    progress: bool = False,
+) -> Gait:
+    """A periodic one-step gait of a one-mode walker that minimises ``objective``.
+
+    ``speed`` (m/s) or ``step_length`` (m) fix the gait's pace (at most one; neither leaves it
+    free). ``objective``: ``"effort"``, ``"cot"`` or an integrand (sympy expression or text in the
+    model's coordinates, velocities, inputs and parameters). ``nodes``: collocation intervals; a
+    list (e.g. ``[20, 60]``) solves on each mesh in turn, each started from the previous solution
+    (mesh refinement: the coarse solve finds the gait, the fine one makes it accurate).
+    ``guess``: a post-impact state to start from (walked passively for one step where that
+    works), ``"passive"`` (the default: a passive step on the system's own gait), ``"stand"``
+    (standing still in the posture of the system's guess for ``step_time``) or ``"interpolate"``
+    (from that posture to the relabelled one); see :func:`~amble.analysis.gait_start.initial_guess`.
+    ``bounds``: ``{state name: (low, high)}`` limits on coordinates or velocities at every point.
+    ``bezier_degree``, ``phase``: the Bézier virtual constraints reported with the gait (the phase
+    an expression of the coordinates, default the hip's distance ahead of the stance foot).
+    ``hzd``: the gait satisfies its virtual constraints exactly — each actuated quantity ``B_jᵀ q``
+    is a Bézier polynomial (coefficients unknowns of the problem) in the phase — so that the HZD
+    controller with the exported ``bezier`` reproduces it (FROST's formulation).
+    ``progress``: solver iterations and constraint violation on stderr.
+
+    Raises :class:`ParameterError` / :class:`StateError` / :class:`ModelError` on bad input and
+    :class:`SolverError` (naming the reason and the most violated constraint) when IPOPT fails.
+    """
+    ca = casadi_module()
+    if speed is not None and step_length is not None:
+        raise ParameterError("give speed or step_length, not both")
+    for name, v in (("speed", speed), ("step_length", step_length), ("mu", mu), ("step_time", step_time)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise ParameterError(f"{name} must be a finite number > 0, got {v!r}")
+    if clearance is not None and not (np.isfinite(clearance) and clearance >= 0):
+        raise ParameterError(f"clearance must be a finite number ≥ 0, got {clearance!r}")
+    sizes = [nodes] if isinstance(nodes, int) else list(nodes)
+    if not sizes or not all(isinstance(k, int) and 2 <= k <= 2000 for k in sizes):
+        raise ParameterError(f"nodes must be an integer in [2, 2000] (or a list of them), got {nodes!r}")
+    if not (isinstance(bezier_degree, int) and 1 <= bezier_degree <= 20):
+        raise ParameterError(f"bezier_degree must be an integer in [1, 20], got {bezier_degree!r}")
+    if not (isinstance(max_iter, int) and max_iter >= 1):
+        raise ParameterError(f"max_iter must be an integer ≥ 1, got {max_iter!r}")
+    pvals = _parameters(system, params)
+    model = system.modes[system.mode_names[0]]
+    integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
+    fns = step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
+    n, nu, d = fns.n, fns.nu, fns.dims
+    P = np.array([pvals[k] for k in fns.param_names])
+
+    levels = [nodes] if isinstance(nodes, int) else list(nodes)
+    x_guess, t_guess = initial_guess(system, fns, pvals, guess, levels[0], step_time)
+    warm: Gait | None = None
+    total_iter, total_time = 0, 0.0
+
+    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None, hzd: bool) -> Gait:
+        # ------------------------------------------------------------------ unknowns
+        # MX with each model function mapped over the points: the graph holds one copy of each
+        # function, not 2N + 1 inlined ones (building the problem is then independent of N)
+        K = 2 * N + 1
+        X, A, U = ca.MX.sym("x", 2 * n, K), ca.MX.sym("a", n, K), ca.MX.sym("u", nu, K)
+        Tv, QE, LAM = ca.MX.sym("T"), ca.MX.sym("qe", n + d), ca.MX.sym("lam", d)
+        cot = isinstance(objective, str) and objective == "cot"
+        PW = ca.MX.sym("power", 2 * nu if cot else 0, K)  # positive and negative parts of each input's power
+        Mb = bezier_degree
+        AL = ca.MX.sym("alpha", nu if hzd else 0, Mb + 1)  # Bézier coefficients of the virtual constraints
+        w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(AL))
+        h = Tv / N
+        taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
+        Q, V = X[:n, :], X[n:, :]
+        F = ca.vertcat(V, A)
+
+        groups: list[tuple[str, Any, float, float]] = []  # (name, expression, lower, upper)
+
+        def add(name: str, expr: Any, lo: float = 0.0, hi: float = 0.0) -> None:
+            if expr.numel():
+                groups.append((name, ca.vec(expr), lo, hi))
+
+        add("dynamics", fns.dynamics.map(K)(Q, V, A, U, taus, P))
+        add("collocation", ca.vertcat(*defects([X[:, 0:-1:2], X[:, 1::2], X[:, 2::2]],
+                                               [F[:, 0:-1:2], F[:, 1::2], F[:, 2::2]], h)))
+        qN, vN = X[:n, -1], X[n:, -1]
+        add("impact", fns.impact(qN, vN, QE, LAM, P))
+        add("periodicity", fns.relabel(qN, QE, P) - X[:, 0])
+        add("guard", fns.guard(qN, vN, P))
+        add("guard_enabled", fns.enabled(qN, vN, P), 0.0, np.inf)
+        L = fns.distance(qN, P)
+        if speed is not None:
+            add("speed", L - speed * Tv)
+        elif step_length is not None:
+            add("step_length", L - step_length)
+        nrm = fns.normal(P)
+        add("impact_impulse", ca.dot(nrm, LAM), 0.0, np.inf)
+        add("liftoff", ca.dot(nrm, QE[n:]), 0.0, np.inf)
+        forces = fns.contact.map(K)(Q, V, A, P)  # d × K
+        normals = ca.mtimes(nrm.T, forces)
+        add("contact", normals, 0.0, np.inf)
+        if mu is not None:
+            tangential = forces - ca.mtimes(nrm, normals)
+            add("friction", mu**2 * normals**2 - ca.sum1(tangential**2), 0.0, np.inf)
+        if clearance is not None and K > 2:
+            s_ = np.arange(1, K - 1) / (K - 1)
+            lift = fns.guard.map(K - 2)(Q[:, 1:-1], V[:, 1:-1], P)
+            add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
+        if hzd:
+            add("virtual_constraints", virtual_constraints(fns, X, P, x_guess, AL))
+
+        # ------------------------------------------------------------------ objective
+        wts = ca.DM(simpson_weights(N))
+        if objective == "effort":
+            run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
+            scale = 1.0
+        elif cot:
+            add("power", U * fns.actuator_rates.map(K)(Q, V, P) - (PW[:nu, :] - PW[nu:, :]))
+            run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
+            scale = 1.0 / float(fns.weight(P))
+        else:
+            run = fns.integrand.map(K)(Q, V, U, taus, P)
+            scale = 1.0
+        J = scale * h * ca.mtimes(run, wts) / L
+
+        # ------------------------------------------------------------------ bounds
+        lbw, ubw = _bounds(model, fns, bounds, N, t_guess)
+        lbw = np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)])
+        ubw = np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)])
+        g = ca.vertcat(*[e for _, e, _, _ in groups])
+        lbg = np.concatenate([np.full(e.numel(), lo) for _, e, lo, _ in groups])
+        ubg = np.concatenate([np.full(e.numel(), hi) for _, e, _, hi in groups])
+        alpha0 = (np.array(warm.bezier["alpha"]) if hzd and warm is not None and warm.bezier
+                  else bezier_start(fns, x_guess, P, Mb) if hzd else np.zeros(0))
+        w0 = np.concatenate([_start_vector(fns, x_guess, t_guess, N, P, warm), np.zeros(PW.numel()),
+                             alpha0.ravel(order="F")])
+        n_eq = int(np.sum(lbg == ubg))
+        if n_eq > w.numel():
+            pace = " and a speed or step length" if (speed or step_length) else ""
+            raise ParameterError(f"the gait is over-determined: {n_eq} equations for {w.numel()} unknowns (a "
+                                 f"model with {nu} input(s){pace}); declare actuators or drop the speed or "
+                                 "step length")
+
+        opts = {"ipopt.tol": tol, "ipopt.constr_viol_tol": min(tol, 1e-10), "ipopt.max_iter": max_iter,
+                "ipopt.print_level": 5 if progress else 0, "print_time": False, "ipopt.sb": "yes",
+                "ipopt.mu_strategy": "adaptive"}
+        solver = ca.nlpsol("gait", "ipopt", {"x": w, "f": J, "g": g}, opts)
+        t0 = time.perf_counter()
+        with _stdout_to_stderr(progress):
+            sol = solver(x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
+        elapsed = time.perf_counter() - t0
+        stats = solver.stats()
+        wopt = np.asarray(sol["x"]).ravel()
+        gval = np.asarray(sol["g"]).ravel()
+        report = constraint_report(groups, gval, lbg, ubg, wopt, lbw, ubw, _bound_groups(fns, N))
+        status = stats.get("return_status", "unknown")
+        if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
+            worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
+            reason = _FAILURES.get(status, status.replace("_", " ").lower())
+            binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"
+                       if worst[1]["max_violation"] > tol else "at the starting point" if not stats.get("iter_count")
+                       else "every constraint holds at the last iterate (the optimality conditions do not)")
+            raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
+                              f"{binding}")
+        return _gait(system, model, fns, pvals, wopt, N, objective, float(sol["f"]), report,
+                     {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed,
+                      "nodes": N}, bezier_degree)
+
+    theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
+    presolve = hzd and not theta[1] - theta[0] > 1e-9
+    if presolve:
+        # the start does not move (standing): no phase to write virtual constraints in; a first
+        # solve without them finds a step, and the virtual constraints start from it
+        levels = [levels[0], *levels]
+    for i, N in enumerate(levels):
+        if warm is not None:  # a finer mesh starts from the coarser solution, interpolated
+            tau = np.linspace(0.0, warm.step_time, 2 * N + 1)
+            x_guess, t_guess = warm.state(tau), warm.step_time
+        warm = solve(N, x_guess, t_guess, warm, hzd and not (presolve and i == 0))
+        total_iter += warm.solver["iterations"]
+        total_time += warm.solver["time_s"]
+    assert warm is not None
+    warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
+    return warm
+
+
+def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:
+    values = dict(system.parameters)
+    for k, v in (params or {}).items():
+        if k not in values:
+            raise ParameterError(f"unknown parameter {k!r} (parameters: {', '.join(values)})")
+        if not np.isfinite(v):
+            raise ParameterError(f"parameter {k!r} must be finite, got {v!r}")
+        values[k] = float(v)
+    system.check_parameters(values)
+    return values
+
+
+def _integrand(model: Any, objective: Any) -> sp.Expr:
+    return _expression(model, objective, "objective", [*model.qd, *(getattr(model, "inputs", []) or [])],
+                       "objectives: effort, cot, or an expression in ")
+
+
+def _expression(model: Any, text: Any, what: str, extra: Sequence[sp.Symbol] = (), hint: str = "") -> sp.Expr:
+    """A user expression (text or sympy) in the coordinates, parameters and ``extra`` symbols."""
+    known = {str(s): s for s in [*model.q, *model.params, *extra]}
+    if isinstance(text, str):
+        try:
+            expr = sp.sympify(text, locals=known)
+        except (sp.SympifyError, SyntaxError, TypeError) as e:
+            raise ParameterError(f"{what} {text!r} is not an expression ({e})") from None
+    else:
+        expr = sp.sympify(text)
+    bad = sorted(str(s) for s in expr.free_symbols if str(s) not in known or known[str(s)] != s)
+    if bad:
+        raise ParameterError(f"{what} {text!s} uses {', '.join(bad)}: not among the allowed names "
+                             f"({hint}{', '.join(known)})")
+    return expr
+
+
+def _bounds(model: Any, fns: StepFunctions, bounds: Mapping | None, N: int, t_guess: float
+            ) -> tuple[np.ndarray, np.ndarray]:
+    n, d, K = fns.n, fns.dims, 2 * N + 1
+    lo_x, hi_x = np.full(2 * n, -np.inf), np.full(2 * n, np.inf)
+    limits = dict(getattr(model.tree, "limits", {}) or {}) if getattr(model, "tree", None) is not None else {}
+    limits.update(bounds or {})
+    for name, (lo, hi) in limits.items():
+        if name not in fns.state_names:
+            raise StateError(f"bound on {name!r}: not a state variable ({', '.join(fns.state_names)})")
+        i = fns.state_names.index(name)
+        lo_x[i] = -np.inf if lo is None else lo
+        hi_x[i] = np.inf if hi is None else hi
+    lim = getattr(model, "input_limits", {}) or {}
+    hi_u = np.array([np.inf if lim.get(k) is None else float(lim[k]) for k in fns.input_names])
+    T_lo, T_hi = 0.02 * t_guess, 20.0 * t_guess
+    lbw = np.concatenate([np.tile(lo_x, K), np.full(n * K, -np.inf), np.tile(-hi_u, K), [T_lo],
+                          np.full(n + 2 * d, -np.inf)])
+    ubw = np.concatenate([np.tile(hi_x, K), np.full(n * K, np.inf), np.tile(hi_u, K), [T_hi],
+                          np.full(n + 2 * d, np.inf)])
+    return lbw, ubw
+
+
+def _bound_groups(fns: StepFunctions, N: int) -> list[tuple[str, int, int]]:
+    """Where each kind of bound sits in the vector of unknowns: (name, start, stop)."""
+    n, nu, K = fns.n, fns.nu, 2 * N + 1
+    s = 2 * n * K + n * K
+    return [("joint_limits", 0, 2 * n * K), ("actuator_limits", s, s + nu * K), ("step_time", s + nu * K,
+                                                                                   s + nu * K + 1)]
+
+
+def _start_vector(fns: StepFunctions, x: np.ndarray, T: float, N: int, P: np.ndarray, warm: Gait | None = None
+                  ) -> np.ndarray:
+    """Unknowns from a guessed trajectory ``x`` (``(2N + 1) × 2n``): accelerations by differences,
+    inputs zero, the impact's unknowns from the guessed pre-impact state; from a coarser solution
+    ``warm``, its accelerations, inputs and impulse interpolated."""
+    n, nu, d, K = fns.n, fns.nu, fns.dims, 2 * N + 1
+    tau = np.linspace(0.0, T, K)
+    a = np.gradient(x[:, n:], tau, axis=0) if K > 2 else np.zeros((K, n))
+    u = np.zeros((K, nu))
+    qe, lam = np.concatenate([x[-1, n:], np.zeros(d)]), np.zeros(d)
+    if warm is not None:
+        a = np.column_stack([np.interp(tau, warm.times, warm.accelerations[:, i]) for i in range(n)])
+        u = warm.input(tau) if nu else u
+        qe, lam = warm.extended_velocity, warm.impulse
+    return np.concatenate([x.ravel(), a.ravel(), u.ravel(), [T], qe, lam])
+
+
+def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: np.ndarray, N: int,
+          objective: Any, value: float, report: dict, solver: dict, degree: int) -> Gait:
+    n, nu, K = fns.n, fns.nu, 2 * N + 1
+    X = w[: 2 * n * K].reshape(K, 2 * n)
+    A = w[2 * n * K: 3 * n * K].reshape(K, n)
+    U = w[3 * n * K: (3 * n + nu) * K].reshape(K, nu)
+    T = float(w[(3 * n + nu) * K])
+    base = (3 * n + nu) * K + 1
+    qe, impulse = w[base: base + n + fns.dims], w[base + n + fns.dims: base + n + 2 * fns.dims]
+    P = np.array([pvals[k] for k in fns.param_names])
+    L = float(fns.distance(X[-1, :n], P))
+    forces = np.array([np.asarray(fns.contact(x[:n], x[n:], a, P), float).ravel() for x, a in zip(X, A)])
+    return Gait(system=system.name, state_names=list(fns.state_names), input_names=list(fns.input_names),
+                params=pvals, objective_name=str(objective), objective=value, fixed_point=X[0].copy(),
+                step_time=T, step_length=L, speed=L / T, times=np.linspace(0.0, T, K), states=X,
+                accelerations=A, inputs=U, pre_impact_state=X[-1].copy(), impulse=np.asarray(impulse),
+                extended_velocity=np.asarray(qe), contact_forces=forces,
+                constraints=report, solver=solver, bezier=bezier_fit(model, fns, X, degree, P))
+
+
+class _stdout_to_stderr:
+    """Solver progress belongs on stderr (stdout may carry JSON). CasADi hands IPOPT's lines to
+    Python's ``sys.stdout``, and C code may print to the process's descriptor 1: both go to stderr."""
+
+    def __init__(self, active: bool) -> None:
+        self.active = active
+
+    def __enter__(self) -> None:
+        if self.active:
+            sys.stdout.flush()
+            self.saved_py = sys.stdout
+            sys.stdout = sys.stderr
+            self.saved = os.dup(1)
+            os.dup2(2, 1)
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.active:
+            sys.stdout.flush()
+            sys.stdout = self.saved_py
+            try:
+                import ctypes
+
+                ctypes.CDLL(None).fflush(None)  # C-level buffers go to stderr before fd 1 is restored
+            except (OSError, AttributeError):  # pragma: no cover - no C library handle
+                pass
+            os.dup2(self.saved, 1)
+            os.close(self.saved)

@@ -1,0 +1,83 @@
+"""Starting trajectories of a gait optimisation: a passive step, or standing still."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..backend.casadi_export import StepFunctions
+from ..errors import ConvergenceError, ParameterError, StateError
+from ..modelling.hybrid import HybridSystem
+from ..simulation.simulate import simulate
+from .poincare import default_guess
+
+#: step time (s) of a standing or interpolated start unless one is given
+STAND_STEP_TIME = 0.5
+#: the kinds of starting trajectory (besides a state)
+GUESSES = ("passive", "stand", "interpolate")
+#: passive steps walked from the system's guess before the step that starts an optimisation
+SETTLE_STEPS = 30
+
+
+def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, float], guess: Any, N: int,
+                  step_time: float | None) -> tuple[np.ndarray, float]:
+    """States at the ``2N + 1`` collocation points and the step time (s) to start from.
+
+    ``guess`` ``None``/``"passive"``: the passive walk from the system's fixed-point guess (or
+    default start) settled over a few steps (:func:`~amble.analysis.poincare.default_guess`: a
+    stable passive gait where there is one), then one step; a state: one passive step from it;
+    ``"stand"``: the posture of the system's guess (or of the given state), held still with zero
+    velocities; ``"interpolate"``: from that posture to its relabelled one at constant rates. A
+    passive step that does not end in a footfall falls back to ``"interpolate"``. ``step_time``
+    (s) is the duration of the last two.
+    """
+    K, n = 2 * N + 1, fns.n
+    if isinstance(guess, str) and guess not in GUESSES:
+        raise ParameterError(f"guess must be one of {', '.join(GUESSES)} or a state, got {guess!r}")
+    kind = guess if isinstance(guess, str) else ("passive" if guess is None else "state")
+    if kind != "state":
+        start = system.fixed_point_guess
+        if start is None:
+            start = system.default_start.get(system.mode_names[0])
+        if start is None:
+            raise StateError(f"system {system.name!r} has no fixed-point guess or start: give guess=<state>")
+        x0 = np.asarray(start, float)
+        if kind == "passive" and len(x0) == 2 * n:
+            try:
+                x0 = np.asarray(default_guess(system, params, steps=SETTLE_STEPS), float)
+            except ConvergenceError:
+                pass  # walking does not settle: start from the guess itself
+    else:
+        x0 = np.asarray(guess, float)
+    if x0.shape != (2 * n,) or not np.all(np.isfinite(x0)):
+        raise StateError(f"guess must be {2 * n} finite numbers ({', '.join(fns.state_names)}), got {x0.tolist()}")
+    T = step_time or STAND_STEP_TIME
+    if kind in ("passive", "state"):
+        walked = _passive_step(system, x0, params, step_time)
+        if walked is not None:
+            t, x = walked
+            tau = np.linspace(0.0, t[-1], K)
+            return np.column_stack([np.interp(tau, t, x[:, i]) for i in range(2 * n)]), float(t[-1])
+    q0 = x0[:n]
+    if kind == "stand":
+        return np.tile(np.concatenate([q0, np.zeros(n)]), (K, 1)), T
+    # the relabelling of a footfall swaps legs, so (as an involution) it maps the first posture to the last
+    P = np.array([params[k] for k in fns.param_names])
+    qN = np.asarray(fns.relabel(q0, np.zeros(n + fns.dims), P), float).ravel()[:n]
+    s = np.linspace(0.0, 1.0, K)[:, None]
+    return np.hstack([(1 - s) * q0 + s * qN, np.tile((qN - q0) / T, (K, 1))]), T
+
+
+def _passive_step(system: HybridSystem, x0: np.ndarray, params: dict[str, float], step_time: float | None
+                  ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Times and states of one passive step from ``x0`` up to its footfall (pre-impact), or None."""
+    limit = 4 * step_time if step_time else None
+    tr = simulate(system, x0, params=params, steps=1, sample_dt=1e-3, max_step_time=limit)
+    ev = tr.step_events
+    if tr.status != "completed" or not ev:
+        return None
+    keep = tr.t < ev[0].t
+    t = np.concatenate([tr.t[keep], [ev[0].t]])
+    x = np.vstack([tr.x[keep], ev[0].x_pre])
+    return t, x

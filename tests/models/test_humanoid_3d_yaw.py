@@ -1,0 +1,81 @@
+"""The 3D humanoid against conservation laws at the impact, and its walking."""
+
+import numpy as np
+import pytest
+
+from amble import simulate
+from amble.backend.kernels import build
+from amble.models import load
+from amble.simulation.simulate import parameter_vector
+
+MIRROR = np.array([-1.0, 1.0, -1.0])  # angular momentum (a pseudovector) under the y → −y relabel
+
+
+@pytest.fixture(scope="module")
+def humanoid():
+    return load("humanoid-3d-yaw")
+
+
+def _frame(q):
+    """Upper-body orientation Ry(torso)·Rx(−torso_cor)·Rz(yaw), written out independently in numpy."""
+    t, c, y = q[4], -q[5], q[6]
+    ry = np.array([[np.cos(t), 0, np.sin(t)], [0, 1, 0], [-np.sin(t), 0, np.cos(t)]])
+    rx = np.array([[1, 0, 0], [0, np.cos(c), -np.sin(c)], [0, np.sin(c), np.cos(c)]])
+    rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
+    return ry @ rx @ rz
+
+
+def _momentum(k, p, x, about):
+    """Angular momentum (kg·m²/s, world axes) about ``about``: point masses plus the upper body's spin R·I·ω."""
+    pos, vel = k.kinematics_rows([0.0], [0], x, p)
+    names = k.meta["points"]
+    par = dict(zip(k.meta["params"], p))
+    masses = {"hip": par["mh"], "stance_mass": par["m"], "swing_mass": par["m"], "torso": par["mt"]}
+    h = sum(m * np.cross(pos[0][names.index(n)] - about, vel[0][names.index(n)]) for n, m in masses.items())
+    q, qd, eps = x[:7], x[7:], 1e-6
+    R = _frame(q)
+    W = R.T @ (_frame(q + eps * qd) - _frame(q - eps * qd)) / (2 * eps)  # [ω]ₓ in body axes
+    omega = np.array([W[2, 1], W[0, 2], W[1, 0]])
+    return h + R @ (np.diag([par["I_xy"], par["I_xy"], par["I_z"]]) @ omega)
+
+
+def test_impact_conserves_3d_angular_momentum_and_never_adds_energy(humanoid):
+    k = build(humanoid)
+    p = parameter_vector(k, None)
+    names = k.meta["points"]
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        x = np.concatenate([rng.uniform(-0.4, 0.4, 7), rng.uniform(-2, 2, 7)])
+        _, post = k.reset("heel_strike", 0.0, x, p)
+        foot = k.kinematics_rows([0.0], [0], x, p)[0][0][names.index("swing_foot")]
+        h0 = _momentum(k, p, x, foot)
+        h1 = MIRROR * _momentum(k, p, post, np.zeros(3))  # new stance foot at the origin, y mirrored
+        assert np.allclose(h1, h0, rtol=0, atol=1e-10 * max(1.0, np.abs(h0).max()))  # ω by central differences
+        e0 = k.energy_rows([0.0], [0], x, p)[0, 0]
+        e1 = k.energy_rows([0.0], [0], post, p)[0, 0]
+        assert e1 <= e0 * (1 + 1e-12)
+
+
+def test_walks_50_steps_with_bounded_sway(humanoid):
+    tr = simulate(humanoid, steps=50)
+    assert tr.status == "completed" and tr.steps == 50
+    sway = np.abs(np.array([e.x_post[2] for e in tr.step_events]))  # stance coronal angle after each step
+    assert sway.max() < 0.1
+
+
+def test_upright_sagittal_start_is_attracted_to_the_default_gait(humanoid):
+    # the humanoid-2d gait with every coronal angle and the yaw at zero: a different state that a
+    # stable cycle must pull onto the default (fixed-point) start
+    x0 = [-0.2206, 0.3206, 0, 0, -0.0442, 0, 0, 0.971, 0.411, 0, 0, 0.464, 0, 0]
+    tr = simulate(humanoid, x0, steps=50, sample_dt=0.0)
+    assert tr.status == "completed"
+    assert np.allclose(tr.final_post_impact_state, humanoid.default_start["humanoid-3d-yaw"], atol=1e-6)
+
+
+def test_stable_limit_cycle(humanoid):
+    from amble.analysis.poincare import find_fixed_point
+
+    lc = find_fixed_point(humanoid)
+    assert lc.residual < 1e-9
+    assert lc.stable and np.all(np.abs(lc.multipliers) < 1)
+    assert np.allclose(lc.fixed_point, humanoid.fixed_point_guess, atol=1e-8)

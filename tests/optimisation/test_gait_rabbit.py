@@ -1,0 +1,40 @@
+"""RABBIT's proportions (``tests/data/rabbit.urdf``, a 5-link planar biped with a pivoting point
+foot and four actuated joints): a 0.8 m/s gait from standing still, feasible to 1e-8. (No
+``rabbit`` model in the library yet; this is the URDF guide's walker with actuators added.)"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("casadi")
+
+from amble import Model, walker  # noqa: E402
+from amble.analysis.gait_optimisation import optimize_gait  # noqa: E402
+from amble.modelling.tree import Joint  # noqa: E402
+
+URDF = Path(__file__).resolve().parents[1] / "data" / "rabbit.urdf"
+
+
+def rabbit_walker():
+    m = Model.from_urdf(URDF, base="left_foot", base_joint=Joint("revolute", axis=(0, 1, 0)),
+                        base_coordinate="stance")
+    q = {str(s): s for s in m.q}
+    swap = {q["left_knee"]: q["right_knee"], q["left_hip"]: q["right_hip"], q["right_hip"]: q["left_hip"],
+            q["right_knee"]: q["left_knee"],
+            q["stance"]: q["stance"] - q["left_knee"] - q["left_hip"] + q["right_hip"] + q["right_knee"]}
+    for j in ("left_hip", "left_knee", "right_hip", "right_knee"):
+        m.actuator(f"u_{j}", on=q[j], limit=150.0)
+    names = [str(s) for s in m.q]
+    stand = np.zeros(2 * len(names))
+    stand[names.index("left_hip")], stand[names.index("right_hip")] = 0.25, -0.25
+    return walker(m, foot="right_foot", hip="torso", slope=0.0, relabel=swap, start=list(stand))
+
+
+@pytest.mark.slow
+def test_rabbit_walks_at_0_8_m_per_s_from_standing():
+    g = optimize_gait(rabbit_walker(), speed=0.8, guess="stand", step_time=0.4, nodes=20)
+    assert g.max_violation <= 1e-8
+    assert g.step_length / g.step_time == pytest.approx(0.8, rel=1e-9)
+    assert g.constraints["contact"]["max_violation"] <= 1e-8
+    assert np.abs(g.inputs).max() <= 150.0 + 1e-8
