@@ -91,7 +91,7 @@ def sweep_continuation(
     _, _, snames = compiled(system, params, [param])
     sweep_values([start, stop], param, system)  # finite, inside the parameter's domain
     cols = continuation_columns(param, snames)
-    with ResultStore(out, list(cols), ["branch", "row", "i"]) as store:
+    with ResultStore(out, cols, ["branch", "row", "i"]) as store:  # typed: a damaged row is not trusted
         before = len(store.rows)
         try:
             branches = cascade(system, param, start, stop, levels=levels, params=params, guess=guess,

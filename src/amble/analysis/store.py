@@ -23,10 +23,13 @@ converts columns back to numbers on demand.
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import json
 import math
 import os
+import tempfile
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,12 +40,27 @@ import numpy as np
 from ..errors import OutputError
 
 
+class ResultFileWarning(UserWarning):
+    """Rows of a result file that cannot be read back as their column types were ignored (they are
+    computed again)."""
+
+
 class ResultStore:
     """Append-only CSV journal of sweep rows keyed by ``key`` columns (see module docstring).
 
     ``path``: ``FILE.csv``, ``FILE.parquet`` or ``None`` (rows kept in memory only); existing
-    rows are loaded on construction. ``columns``: every column, in file order; ``key``: the
-    columns that identify a point (first row of a key wins).
+    rows are loaded on construction. ``columns``: every column, in file order, or a mapping of
+    each column to its type (:data:`COLUMN_TYPES`): a row read from the file whose cell is not
+    of its column's type (``step_time`` = ``abc``: a damaged or edited file) is then ignored with
+    a :class:`ResultFileWarning`, so the point is computed again instead of counted as ``ok``.
+    ``key``: the columns that identify a point (first row of a key wins).
+
+    Writability is checked on construction, before any work: a file must be creatable in the
+    directory (every rewrite goes through a temporary file there) and an existing journal must
+    be writable. Should a write still fail (a full disk, ``ENOSPC``), it is an
+    :class:`OutputError` that leaves the journal as it was before the write: rows already
+    appended are kept, and running the same sweep again resumes from them. A file that cannot be
+    read (not UTF-8 text, not Parquet) is an :class:`OutputError` too; it is never overwritten.
 
     A store with a file holds an exclusive advisory lock on ``.FILE.lock`` from construction to
     :meth:`close` (it is a context manager): a second sweep on the same file is refused with an
@@ -50,9 +68,13 @@ class ResultStore:
     of the other).
     """
 
-    def __init__(self, path: str | os.PathLike | None, columns: Sequence[str], key: Sequence[str]) -> None:
+    def __init__(self, path: str | os.PathLike | None, columns: Sequence[str] | Mapping[str, str],
+                 key: Sequence[str]) -> None:
         self.columns = list(columns)
+        self.types: dict[str, str] = dict(columns) if isinstance(columns, Mapping) else {}
         self.key = list(key)
+        self.ignored = 0  # rows of the file that were not of their columns' types
+        self._first_ignored = ""
         self.final: Path | None = Path(path) if path is not None else None
         if self.final is not None and self.final.suffix.lower() not in (".csv", ".parquet"):
             raise OutputError(f"result file {str(self.final)!r} must end with .csv or .parquet")
@@ -61,6 +83,7 @@ class ResultStore:
         self.rows: dict[tuple[str, ...], dict[str, str]] = {}
         self._lock = _lock(self.final) if self.final is not None else None
         try:
+            self._check_writable()
             self._load()
         except BaseException:
             self.close()
@@ -78,18 +101,29 @@ class ResultStore:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+    def _check_writable(self) -> None:
+        """:class:`OutputError` now, before any work, if the file could not be written later."""
+        if self.final is None:
+            return
+        where = self.final.parent if str(self.final.parent) else Path(".")
+        try:  # a real file, not permission bits: also right for root and read-only file systems
+            fd, probe = tempfile.mkstemp(prefix=f".{self.final.name}.", suffix=".probe", dir=where)
+            os.close(fd)
+            os.unlink(probe)
+            if self.journal is not None and self.journal.exists():
+                open(self.journal, "ab").close()  # opening to append changes nothing
+        except OSError as e:
+            raise OutputError(f"cannot write result file {str(self.final)!r} ({e.strerror or e}); "
+                              "choose another file") from None
+
     def _load(self) -> None:
         if self.final is None:
             return
         if self.parquet and self.final.exists() and self.final.stat().st_size > 0:
-            import pyarrow.parquet as pq
-
-            tab = pq.read_table(self.final)
-            if tab.column_names != self.columns:
-                raise OutputError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
-            for r in tab.to_pylist():
-                self._add({c: "" if r[c] is None else str(r[c]) for c in self.columns})
+            for r in self._read_parquet():
+                self._add_read({c: "" if r[c] is None else str(r[c]) for c in self.columns}, "a row")
         if self.journal is None or not self.journal.exists() or self.journal.stat().st_size == 0:
+            self._warn_ignored()
             return
         data = self.journal.read_bytes()
         good = data[: data.rfind(b"\n") + 1]  # a torn last line (killed mid-write) is dropped ...
@@ -97,15 +131,53 @@ class ResultStore:
             with open(self.journal, "r+b") as f:
                 f.truncate(len(good))
                 os.fsync(f.fileno())
-        lines = good.decode().split("\n")[:-1]
+        try:
+            text = good.decode()
+        except UnicodeDecodeError as e:  # not written by a sweep (which writes UTF-8): never guess
+            line = good.count(b"\n", 0, e.start) + 1
+            raise OutputError(f"{str(self.journal)!r} is not a sweep result file (line {line} is not UTF-8 "
+                              "text); use another file") from None
+        lines = text.split("\n")[:-1]
         reader = csv.reader(lines)
         header = next(reader, None)
         if header != self.columns:
             raise OutputError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
                              "use another file")
-        for fields in reader:
+        for n, fields in enumerate(reader, start=2):
             if len(fields) == len(self.columns):
-                self._add(dict(zip(self.columns, fields)))
+                self._add_read(dict(zip(self.columns, fields)), f"line {n}")
+        self._warn_ignored()
+
+    def _read_parquet(self) -> list[dict[str, Any]]:
+        """The rows of the Parquet file; :class:`OutputError` if it is not one of this sweep."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        assert self.final is not None
+        try:
+            tab = pq.read_table(self.final)
+        except (pa.ArrowException, OSError) as e:  # ArrowInvalid: a damaged file or not Parquet
+            first = str(e).splitlines()[0] if str(e) else type(e).__name__
+            raise OutputError(f"{str(self.final)!r} is not a readable Parquet file ({first}); "
+                              "use another file") from None
+        if tab.column_names != self.columns:
+            raise OutputError(f"{str(self.final)!r} holds a different kind of sweep (columns differ)")
+        return tab.to_pylist()
+
+    def _add_read(self, row: Mapping[str, str], where: str) -> None:
+        """Add a row read from the file unless a cell is not of its column's type."""
+        bad = next(((c, row[c]) for c, kind in self.types.items() if not _is_type(row[c], kind)), None)
+        if bad is None:
+            self._add(row)
+            return
+        self.ignored += 1
+        if self.ignored == 1:
+            self._first_ignored = f"{where}: {bad[0]} = {bad[1]!r} is not {self.types[bad[0]]}"
+
+    def _warn_ignored(self) -> None:
+        if self.ignored:
+            warnings.warn(f"{str(self.final)!r}: {self.ignored} damaged row(s) ignored and computed again "
+                          f"({self._first_ignored})", ResultFileWarning, stacklevel=4)
 
     def _add(self, row: Mapping[str, str]) -> bool:
         k = tuple(row[c] for c in self.key)
@@ -143,10 +215,21 @@ class ResultStore:
             w.writerow(self.columns)
         for s in fresh:
             w.writerow([s[c] for c in self.columns])
-        with open(self.journal, "a", newline="") as f:
-            f.write(buf.getvalue())
-            f.flush()
-            os.fsync(f.fileno())
+        size = self.journal.stat().st_size if not new else 0
+        try:
+            with open(self.journal, "a", newline="", encoding="utf-8") as f:
+                f.write(buf.getvalue())
+                f.flush()
+                os.fsync(f.fileno())
+        except OSError as e:
+            for s in fresh:  # not durable: the points are still pending
+                self.rows.pop(tuple(s[c] for c in self.key), None)
+            try:  # the journal as it was: no torn rows of this write
+                os.truncate(self.journal, size)
+            except OSError:
+                pass
+            raise OutputError(f"cannot append to result file {str(self.journal)!r}: {_reason(e)}; the rows "
+                              "written before are kept, run the same sweep again to resume") from None
 
     def sorted_rows(self) -> list[dict[str, str]]:
         """All stored rows, sorted by key."""
@@ -158,22 +241,55 @@ class ResultStore:
             return
         rows = self.sorted_rows()
         tmp = self.final.with_name(f".{self.final.name}.{os.getpid()}.tmp")
+        try:
+            self._write_compacted(rows, tmp)
+            os.replace(tmp, self.final)
+        except OSError as e:  # the journal still holds every row: nothing computed is lost
+            try:
+                tmp.unlink()
+            except OSError:
+                pass
+            raise OutputError(f"cannot write result file {str(self.final)!r}: {_reason(e)}; the {len(rows)} "
+                              f"rows are kept in {str(self.journal)!r}, run the same sweep again to finish "
+                              "it") from None
+        if self.parquet and self.journal is not None and self.journal.exists():
+            self.journal.unlink()
+
+    def _write_compacted(self, rows: list[dict[str, str]], tmp: Path) -> None:
+        """Write the sorted ``rows`` to ``tmp`` in the file's format, durably."""
         if self.parquet:
             import pyarrow as pa
             import pyarrow.parquet as pq
 
             pq.write_table(pa.table({c: [r[c] for r in rows] for c in self.columns}), tmp)
-        else:
-            with open(tmp, "w", newline="") as f:
-                w = csv.writer(f, lineterminator="\n")
-                w.writerow(self.columns)
-                for r in rows:
-                    w.writerow([r[c] for c in self.columns])
-                f.flush()
-                os.fsync(f.fileno())
-        os.replace(tmp, self.final)
-        if self.parquet and self.journal is not None and self.journal.exists():
-            self.journal.unlink()
+            return
+        with open(tmp, "w", newline="", encoding="utf-8") as f:
+            w = csv.writer(f, lineterminator="\n")
+            w.writerow(self.columns)
+            for r in rows:
+                w.writerow([r[c] for c in self.columns])
+            f.flush()
+            os.fsync(f.fileno())
+
+
+def _reason(e: OSError) -> str:
+    """An OS error in words (a full disk named as such)."""
+    if e.errno == errno.ENOSPC:
+        return "no space left on device"
+    return e.strerror or (os.strerror(e.errno) if e.errno else "") or str(e) or type(e).__name__
+
+
+def _is_type(text: str, kind: str) -> bool:
+    """Whether a stored cell reads back as a value of column type ``kind`` (empty: always)."""
+    if text == "" or kind == "str":
+        return True
+    if kind == "bool":
+        return text in ("true", "false")
+    try:
+        parse_value(text, kind)
+    except (ValueError, TypeError):  # json.JSONDecodeError is a ValueError
+        return False
+    return True
 
 
 def _lock(final: Path) -> Any:
@@ -303,4 +419,5 @@ class SweepResult:
         return {"ok": ok, "failed": len(self.rows) - ok}
 
 
-__all__ = ["COLUMN_TYPES", "ResultStore", "SweepResult", "fmt_value", "parse_value", "state_columns", "state_from_row"]
+__all__ = ["COLUMN_TYPES", "ResultFileWarning", "ResultStore",
+           "SweepResult", "fmt_value", "parse_value", "state_columns", "state_from_row"]

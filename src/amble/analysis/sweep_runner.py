@@ -71,7 +71,8 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
     task ``make_task(points, group, store)``, run as ``fn(*task)``. ``computed`` / ``reused``
     of the result count keys.
     """
-    with ResultStore(out, list(columns), key) as store:  # holds the file's lock until the end
+    # the column types let the store ignore a damaged row instead of counting it ok
+    with ResultStore(out, dict(columns), key) as store:  # holds the file's lock until the end
         flat = [kk for ks in keys for kk in ks]
         store.check_keys(flat)
         per = max(1, max((len(ks) for ks in keys), default=1))  # keys per point (a basin row: its cells)

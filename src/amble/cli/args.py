@@ -7,10 +7,15 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
 from ..errors import AmbleError, OutputError
+
+#: Most points of a sweep grid (all ranges together): a million rows of results take about a
+#: gigabyte in memory, and the grid itself is allocated before any work.
+MAX_GRID_POINTS = 1_000_000
 
 
 class UsageError(AmbleError):
@@ -56,6 +61,8 @@ def parse_range(text: str) -> tuple[str, float, float, int]:
         raise UsageError(f"range count {parts[2]!r} is not an integer") from None
     if count < 1:
         raise UsageError(f"range count must be at least 1, got {count}")
+    if count > MAX_GRID_POINTS:  # once an untyped MemoryError (or ValueError) allocating the grid
+        raise UsageError(f"range count must be at most {MAX_GRID_POINTS}, got {count}")
     if count > 1 and start == stop:
         raise UsageError(f"empty range {start}:{stop} with {count} points")
     if start > stop:
@@ -63,11 +70,24 @@ def parse_range(text: str) -> tuple[str, float, float, int]:
     return name.strip(), start, stop, count
 
 
-def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path | None:
-    """``path`` as a :class:`Path` if it could be written, else :class:`OutputError`; creates nothing.
+def check_grid_size(counts: Sequence[int], what: str) -> None:
+    """:class:`UsageError` if a grid of ``counts`` points per axis has more than
+    :data:`MAX_GRID_POINTS` points."""
+    total = math.prod(counts)
+    if total > MAX_GRID_POINTS:
+        raise UsageError(f"{what}: {' × '.join(map(str, counts))} = {total} points, more than the "
+                         f"{MAX_GRID_POINTS} a sweep may have; split it into several sweeps")
 
-    The suffix must be one of ``suffixes``; the directory must exist and be writable, and an
-    existing file must be a regular, writable file."""
+
+def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path | None:
+    """``path`` as a :class:`Path` if it could be written, else :class:`OutputError`; leaves nothing
+    behind.
+
+    The suffix must be one of ``suffixes``; the directory must exist and a file must be creatable
+    in it (outputs are written to a part file there and renamed, :mod:`amble.cli.output`; a probe
+    file is created and removed to find out, which also catches a read-only file system and a
+    process running as root, for whom permission bits say little), and an existing file must be a
+    regular, writable file."""
     if path is None:
         return None
     p = Path(path)
@@ -79,10 +99,16 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
     if p.exists():
         if not p.is_file():
             raise OutputError(f"{what}: {path!r} exists and is not a file")
-        if not os.access(p, os.W_OK):
-            raise OutputError(f"{what}: cannot write {path!r} (permission denied)")
-    elif not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{what}: cannot create {path!r} in {str(parent)!r} (permission denied)")
+        try:
+            open(p, "ab").close()  # opening to append changes nothing
+        except OSError as e:
+            raise OutputError(f"{what}: cannot write {path!r} ({e.strerror or e})") from None
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".probe", dir=parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as e:
+        raise OutputError(f"{what}: cannot create files in {str(parent)!r} ({e.strerror or e})") from None
     return p
 
 

@@ -7,6 +7,7 @@ import argparse
 from typing import Any
 
 from .args import UsageError, _float, load_model, parse_sets, writable_path
+from .output import write_output
 
 
 def parse_bounds(items: list[str] | None) -> dict[str, tuple[float | None, float | None]]:
@@ -75,7 +76,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
                          bezier_degree=args.bezier_degree, progress=not args.quiet)
     out = gait.to_json()
     if out_p:
-        gait.save(out_p)
+        write_output(out_p, gait.save, "--out")
         out["out"] = str(out_p)
     if not args.json:
         sv = gait.solver

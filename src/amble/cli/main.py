@@ -1,15 +1,19 @@
 """The ``amble`` command line: every command is one API call plus input/output.
 
-Exit codes: 0 success, 2 user error (bad model name, parameter, range, path...), 1 internal
-failure or a solver that did not succeed (``SolverError``). Errors are one line on stderr, or
-``{"error": ...}`` on stdout with ``--json``.
+Exit codes: 0 success, 2 user error (bad model name, parameter, range, path, a full disk...),
+1 internal failure or a solver that did not succeed (``SolverError``), 130 interrupted, 141
+standard output closed by its reader (``| head -1``; quiet, as a Unix tool ended by SIGPIPE).
+Errors are one line on stderr, or ``{"error": ...}`` on stdout with ``--json``; warnings are one
+line on stderr.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -19,6 +23,10 @@ from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .equations import cmd_equations
 from .gait import add_parser as add_gait_parser
+from .output import write_output
+
+#: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
+MAX_PERIOD = 1000
 
 MODEL_HELP = ("a library model (see 'amble models') or a model file path/to/file.py[:callable]: the callable, "
               "else the file's build(), else the one HybridSystem it defines")
@@ -77,8 +85,9 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         from ..viz.movie import check_writer
 
         check_writer(anim_p)
-    if args.steps is not None and args.steps < 1:
-        raise UsageError(f"--steps must be at least 1, got {args.steps}")
+    most = Options().max_events  # a run ends at this many events whatever --steps asks
+    if args.steps is not None and not 1 <= args.steps <= most:
+        raise UsageError(f"--steps must be at least 1 and at most {most}, got {args.steps}")
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
     s = load_model(args.model)
@@ -90,17 +99,15 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
                   sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
     if out_p:
-        tr.save(out_p)
+        write_output(out_p, tr.save, "--out")
         summary["out"] = str(out_p)
     if plot_p:
         from ..viz.plot import plot_trajectory
 
-        plot_trajectory(tr, plot_p)
+        write_output(plot_p, lambda part: plot_trajectory(tr, part), "--plot")
         summary["plot"] = str(plot_p)
     if anim_p:
-        from ..viz.animate import animate
-
-        animate(tr, anim_p)
+        _animate(tr, anim_p)
         summary["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {tr.status} — {tr.message}")
@@ -113,6 +120,17 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     return summary
 
 
+def _animate(tr: Any, path: Any) -> None:
+    """Write the animation of ``tr``: a GIF or MP4 is written atomically by the movie writer itself
+    (its messages name the file), an HTML page through a part file."""
+    from ..viz.animate import animate
+
+    if path.suffix.lower() in (".gif", ".mp4"):
+        animate(tr, path)
+    else:
+        write_output(path, lambda part: animate(tr, part), "--animate")
+
+
 def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     from ..analysis.poincare import find_fixed_point
 
@@ -122,8 +140,8 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         from ..viz.movie import check_writer
 
         check_writer(anim_p)
-    if args.period < 1:
-        raise UsageError(f"--period must be at least 1, got {args.period}")
+    if not 1 <= args.period <= MAX_PERIOD:
+        raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
     s = load_model(args.model)
     params = parse_sets(args.set)
     guess = _start(s, args.guess, params) if args.guess else None
@@ -145,12 +163,10 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         if plot_p:
             from ..viz.plot import plot_limit_cycle
 
-            plot_limit_cycle(tr, plot_p, cycle=lc)
+            write_output(plot_p, lambda part: plot_limit_cycle(tr, part, cycle=lc), "--plot")
             out["plot"] = str(plot_p)
         if anim_p:
-            from ..viz.animate import animate
-
-            animate(tr, anim_p)
+            _animate(tr, anim_p)
             out["animation"] = str(anim_p)
     if not args.json:
         unit = s.time_unit
@@ -285,13 +301,29 @@ def _version() -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _one_line_warning
+        try:
+            return _main(argv)
+        except BrokenPipeError:
+            # the reader went away (``amble models | head -1``), perhaps while an error was being
+            # reported: stop quietly, as Unix tools do when SIGPIPE ends them, and keep Python from
+            # complaining again when it flushes standard output at exit
+            _quiet_stdout()
+            return 141
+
+
+def _main(argv: list[str]) -> int:
     want_json = "--json" in argv
     try:
         args = build_parser().parse_args(argv)
         result = args.func(args)
         if args.json:
             print(json.dumps(result, default=_jsonable))
+        sys.stdout.flush()  # a closed pipe is found here, not at interpreter exit
         return 0
+    except BrokenPipeError:
+        raise  # handled in main()
     except SolverError as e:  # the numbers did not work out (not a user error): one line, exit 1
         if want_json:
             print(json.dumps({"error": str(e), "type": type(e).__name__}))
@@ -313,6 +345,26 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(json.dumps({"error": f"internal error: {type(e).__name__}: {e}", "type": "InternalError"}))
         print(f"amble: internal error: {type(e).__name__}: {e}", file=sys.stderr)
         return 1
+
+
+def _quiet_stdout() -> None:
+    """Point standard output at ``/dev/null`` (the pipe it wrote to is closed)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout replaced by an object without a descriptor
+        pass
+
+
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                      file: Any = None, line: str | None = None) -> None:
+    """A warning as one line on standard error (no source file and line of amble's code)."""
+    text = str(message).splitlines()[0] if str(message) else category.__name__
+    try:
+        print(f"amble: warning: {text.removeprefix('amble: ')}", file=sys.stderr)
+    except OSError:
+        pass
 
 
 def _jsonable(o: Any) -> Any:

@@ -23,7 +23,8 @@ from ..analysis.continuation_sweep import bifurcation_rows, sweep_continuation
 from ..analysis.defaults import BASIN_STEPS
 from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from ..simulation.engine import Options
-from .args import UsageError, load_model, parse_range, parse_sets, writable_path
+from .args import UsageError, check_grid_size, load_model, parse_range, parse_sets, writable_path
+from .output import write_output
 
 
 def sweep_cli(args: Any) -> dict[str, Any]:
@@ -73,16 +74,10 @@ def sweep_cli(args: Any) -> dict[str, Any]:
     if plot is not None:
         from ..viz import sweep_plots as sp
 
-        if basin_kind:
-            sp.plot_basin(res, plot)
-        elif args.kind == "bifurcation":
-            sp.plot_bifurcation(res, plot)
-        elif args.kind == "continuation":
-            sp.plot_continuation(res, plot)
-        elif len(names) == 1:
-            sp.plot_branch(res, plot)
-        else:
-            sp.plot_parameter_map(res, plot)
+        draw = (sp.plot_basin if basin_kind else sp.plot_bifurcation if args.kind == "bifurcation"
+                else sp.plot_continuation if args.kind == "continuation"
+                else sp.plot_branch if len(names) == 1 else sp.plot_parameter_map)
+        write_output(plot, lambda part: draw(res, part), "--plot")
         summary["plot"] = str(plot)
     if not getattr(args, "json", False):
         _print(summary, out, plot)
@@ -99,8 +94,9 @@ def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tup
         if len(xs) != 2:
             raise usage(f"--kind basin needs exactly two --x NAME=START:STOP:COUNT (coordinates of the "
                         f"post-impact state), got {len(xs)}")
-        if steps is not None and steps < 1:
-            raise usage(f"--steps must be at least 1, got {steps}")
+        most = Options().max_events  # a walk ends at this many events whatever --steps asks
+        if steps is not None and not 1 <= steps <= most:
+            raise usage(f"--steps must be at least 1 and at most {most}, got {steps}")
         ranges = []
         for text in xs:
             try:
@@ -109,6 +105,7 @@ def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tup
                 raise usage(str(e).replace("--param", "--x")) from None
         if ranges[0][0] == ranges[1][0]:
             raise usage(f"--x: the two coordinates must differ, got {ranges[0][0]!r} twice")
+        check_grid_size([r[3] for r in ranges], "--x")
         return ranges
     if xs or steps is not None:
         raise usage("--x and --steps apply to --kind basin only")
@@ -121,6 +118,7 @@ def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tup
         raise usage(f"--kind {args.kind} sweeps exactly one --param")
     if len(ranges) == 2 and ranges[0][0] == ranges[1][0]:
         raise usage(f"--param: the two parameters must differ, got {ranges[0][0]!r} twice")
+    check_grid_size([r[3] for r in ranges], "--param")
     return ranges
 
 

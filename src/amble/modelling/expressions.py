@@ -11,11 +11,15 @@ from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
 
+#: Operations sympy keeps unevaluated that compiled code cannot express.
+_UNEVALUATED = (sp.Sum, sp.Product, sp.Integral, sp.Derivative, sp.Limit)
+
 
 def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
     """``value`` as a sympy expression fit for compiled code, or a :class:`ModelError` naming
     ``what``: no unparsable text, no undefined functions, no infinite, undefined or complex
-    constants (code generation would fail on them far from where they were written)."""
+    constants, no unevaluated sums, products, integrals, derivatives or limits (code generation
+    would fail on them far from where they were written)."""
     try:
         e = sp.sympify(value)
     except (sp.SympifyError, TypeError, SyntaxError):
@@ -27,6 +31,10 @@ def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
         raise ModelError(f"model {model!r}: {what} uses undefined function(s) {', '.join(undefined)}")
     if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
         raise ModelError(f"model {model!r}: {what} contains an infinite, undefined or complex value: {e}")
+    pending = sorted({type(a).__name__ for a in e.atoms(*_UNEVALUATED)})
+    if pending:  # C has no Sum(): it reached the compiler as an undeclared function
+        raise ModelError(f"model {model!r}: {what} holds an unevaluated {', '.join(pending)}; write it out "
+                         f"(e.g. with .doit()): {e}")
     return e
 
 

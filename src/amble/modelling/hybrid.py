@@ -20,13 +20,18 @@ Everything here is a declaration; :mod:`amble.codegen` turns it into compiled co
 
 from __future__ import annotations
 
+import dataclasses
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import sympy as sp
+from sympy.core.relational import Relational
 
 from ..errors import ModelError, ParameterError
+from .expressions import checked_expr
+from .geometry import t as _TIME
 from .model import Model
 
 
@@ -167,7 +172,7 @@ class HybridSystem:
         target = target or source
         self._check_mode(source)
         self._check_mode(target)
-        self._check_guard(source, guard)
+        guard = self._check_guard(source, guard)
         _check_reset(self.modes[source], self.modes[target], reset, name)
         tr = Transition(name, source, target, guard, reset, None, step)
         self.transitions.append(tr)
@@ -185,7 +190,7 @@ class HybridSystem:
         for src in sources:
             self._check_mode(src)
             g = guard if isinstance(guard, Guard) else guard(self.modes[src])
-            self._check_guard(src, g)
+            g = self._check_guard(src, g)
             tr = Transition(name if len(sources) == 1 else f"{name}_{src}", src, src, g, None, status, False)
             self.transitions.append(tr)
         assert tr is not None
@@ -265,31 +270,97 @@ class HybridSystem:
         if mode not in self.modes:
             raise ModelError(f"system {self.name!r}: unknown mode {mode!r} (modes: {', '.join(self.modes)})")
 
-    def _check_guard(self, source: str, guard: Guard) -> None:
+    def _check_guard(self, source: str, guard: Any) -> Guard:
+        """``guard`` checked against mode ``source`` and normalised for code generation: the
+        expression and the enabling condition as sympy objects in the mode's symbols (text is
+        read with them), the direction an ``int``, an enabling condition that always holds
+        dropped. Anything the compiled code could not express is a :class:`ModelError` here
+        rather than a C compiler's complaint about ``true``, ``I`` or ``Sum``."""
         m = self.modes[source]
-        if guard.direction not in (-1, 0, 1):
-            raise ModelError(f"system {self.name!r}: guard direction must be -1, 0 or +1")
-        expr = sp.sympify(guard.expr)
-        allowed = set(m.q) | set(m.qd) | set(m.params) | {sp.Symbol("t", real=True)}
+        what = f"guard of mode {source!r}"
+        if not isinstance(guard, Guard):
+            raise ModelError(f"system {self.name!r}: a {what} must be a Guard, got {type(guard).__name__}")
+        d = guard.direction
+        # True == 1 in Python, but a flag where a direction belongs is a mistake (and reached C as 'True')
+        if isinstance(d, bool) or not isinstance(d, numbers.Real) or d not in (-1, 0, 1):
+            raise ModelError(f"system {self.name!r}: {what}: direction must be -1, 0 or +1, got {d!r}")
+        names = {str(s_): s_ for s_ in [*m.q, *m.qd, *m.params, _TIME]}
+        expr = checked_expr(self.name, _read(guard.expr, names, f"system {self.name!r}: {what}: "), what)
+        allowed = set(m.q) | set(m.qd) | set(m.params) | {_TIME}
         if not (expr.free_symbols & (set(m.q) | set(m.qd))):
             raise ModelError(
                 f"system {self.name!r}: a guard of mode {source!r} does not depend on the state: {expr}"
             )
-        for e in (expr, sp.sympify(guard.enabled) if guard.enabled is not None else sp.true):
+        enabled = _condition(self.name, guard.enabled, names, f"{what}: enabling condition")
+        for e in (expr, enabled if enabled is not None else sp.true):
             bad = sorted(str(s) for s in e.free_symbols - allowed)
             if bad:
                 raise ModelError(
                     f"system {self.name!r}: guard of mode {source!r} uses unknown symbols {', '.join(bad)}"
                 )
+        return dataclasses.replace(guard, expr=expr, direction=int(d), enabled=enabled)
+
+
+def _read(value: Any, names: Mapping[str, sp.Symbol], where: str = "") -> Any:
+    """Text parsed with the mode's own symbols (``"x > 0"`` means the real coordinate ``x``);
+    anything else unchanged. Unparsable text is a :class:`ModelError`."""
+    if not isinstance(value, str):
+        return value
+    try:
+        return sp.sympify(value, locals=dict(names))
+    except (sp.SympifyError, TypeError, SyntaxError) as e:
+        raise ModelError(f"{where}cannot read {value!r} as an expression ({type(e).__name__})") from None
+
+
+def _condition(system: str, value: Any, names: Mapping[str, sp.Symbol], what: str) -> Any:
+    """An enabling condition as a sympy boolean of comparisons, or ``None`` if it always holds.
+
+    Comparisons (``<``, ``>``, ``Eq`` ...) of checked expressions, joined by ``&``, ``|``, ``~``,
+    are accepted; a condition that is always false (the guard could never fire), a number, a
+    bare symbol or anything else is a :class:`ModelError`."""
+    if value is None:
+        return None
+    try:
+        e = sp.sympify(_read(value, names, f"system {system!r}: {what}: "))
+    except (sp.SympifyError, TypeError, SyntaxError):
+        raise ModelError(f"system {system!r}: {what} is not a condition: {value!r}") from None
+    if e is sp.true:
+        return None
+    if e is sp.false:
+        raise ModelError(f"system {system!r}: {what} is always false, so the guard could never fire: {value!r}")
+    _check_condition(system, e, what)
+    return e
+
+
+def _check_condition(system: str, e: Any, what: str) -> None:
+    if isinstance(e, (sp.And, sp.Or, sp.Not, sp.Xor)):
+        for a in e.args:
+            _check_condition(system, a, what)
+    elif isinstance(e, Relational):
+        for side in (e.lhs, e.rhs):
+            checked_expr(system, side, what)
+    else:
+        raise ModelError(f"system {system!r}: {what} must be a comparison such as foot_x > 0 (or several joined "
+                         f"by &, |, ~), got {e!r}")
 
 
 def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = False,
                  source: Model | None = None) -> list[sp.Expr]:
     """Order a relabel mapping (or sequence) by the target mode's coordinates. With a mapping, a
-    target coordinate that the source mode also has and the mapping omits is kept as it is."""
+    target coordinate that the source mode also has and the mapping omits is kept as it is.
+
+    Each value is a checked expression (:func:`~amble.modelling.expressions.checked_expr`: no
+    ``I``, ``zoo``, unevaluated ``Sum`` or undefined function reaches the compiler); text is read
+    with the source mode's symbols."""
     names = [str(s) for s in (target.qd if velocities else target.q)]
+    known = {str(s_): s_ for s_ in [*source.q, *source.qd, *source.params, _TIME]} if source is not None else {}
+    model = source.name if source is not None else target.name
+
+    def value(v: Any) -> sp.Expr:
+        return checked_expr(model, _read(v, known, f"{what}: "), what)
+
     if isinstance(mapping, Mapping):
-        given = {str(k): sp.sympify(v) for k, v in mapping.items()}
+        given = {str(k): value(v) for k, v in mapping.items()}
         unknown = sorted(set(given) - set(names))
         if unknown:
             raise ModelError(f"{what}: {', '.join(unknown)} not among the target coordinates {names}")
@@ -300,7 +371,9 @@ def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = Fals
         if missing:
             raise ModelError(f"{what}: no value for target coordinate(s) {', '.join(missing)}")
         return [given[n] for n in names]
-    seq = [sp.sympify(v) for v in (list(mapping) if not isinstance(mapping, sp.MatrixBase) else list(mapping))]
+    if isinstance(mapping, (str, bytes)) or not isinstance(mapping, (Sequence, sp.MatrixBase)):
+        raise ModelError(f"{what}: expected a mapping or a sequence of {len(names)} values, got {mapping!r}")
+    seq = [value(v) for v in list(mapping)]
     if len(seq) != len(names):
         raise ModelError(f"{what}: {len(seq)} values for {len(names)} target coordinates")
     return seq
@@ -314,7 +387,7 @@ def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
         exprs = target_exprs(dst, reset.relabel, what, source=src)
         _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
     elif isinstance(reset, Lock):
-        c = sp.sympify(reset.constraint)
+        c = checked_expr(src.name, reset.constraint, f"{what}: lock constraint")
         if not (c.free_symbols & set(src.q)):
             raise ModelError(f"{what}: lock constraint {c} does not depend on the coordinates")
         exprs = target_exprs(dst, reset.relabel, what, source=src)

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
+import operator
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -26,6 +29,9 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: Hyb
     ``system``) values outside a parameter's declared domain are :class:`ParameterError`."""
     names = k.meta["params"]
     p = np.array(k.meta["param_defaults"], dtype=float)
+    if params is not None and not isinstance(params, Mapping):  # a list of pairs or of names reads ambiguously
+        raise ParameterError(f"params must be a mapping of parameter names to values (e.g. {{'slope': 0.05}}), "
+                             f"got a {type(params).__name__}")
     if params:
         for key, val in params.items():
             if key not in names:
@@ -46,6 +52,8 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: Hyb
 
 def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, mode: str | None
                   ) -> tuple[int, np.ndarray]:
+    if mode is not None and not isinstance(mode, str):
+        raise StateError(f"mode must be a mode name ({', '.join(k.meta['modes'])}), got {mode!r}")
     mode = mode or k.meta["modes"][0]
     mi = k.mode_index(mode)
     names = k.meta["state_names"][mode]
@@ -53,7 +61,12 @@ def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, 
         if mode not in system.default_start:
             raise StateError(f"system {system.name!r} has no default start for mode {mode!r}; give x0")
         x0 = system.default_start[mode]
-    x = np.asarray(x0, dtype=float).ravel()
+    if isinstance(x0, (str, bytes)):  # NumPy would read "1.5" as one number and fail on "abcd"
+        raise StateError(f"initial state must be a sequence of numbers ({', '.join(names)}), got {x0!r}")
+    try:
+        x = np.asarray(x0, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise StateError(f"initial state must be a sequence of numbers ({', '.join(names)}), got {x0!r}") from None
     if x.size != len(names):
         raise StateError(
             f"initial state has {x.size} values, mode {mode!r} needs {len(names)}: {', '.join(names)}"
@@ -106,23 +119,30 @@ def simulate(
         ``"dop853"`` (explicit, the default) or ``"radau"`` (implicit Radau IIA with the model's
         exact Jacobian, for stiff systems); default that of ``options``.
     """
-    k = build(system)
-    p = parameter_vector(k, params, system)
-    mi, x = initial_state(system, k, x0, mode)
-    if steps is not None and steps < 1:
-        raise StateError(f"steps must be at least 1, got {steps}")
+    base = options or Options()
+    if not isinstance(base, Options):
+        raise StateError(f"options must be an amble Options, got {type(base).__name__}")
+    # the type of every argument is checked before any work: a string or a list compared with a
+    # number would otherwise surface as a TypeError deep inside
+    steps = _count(steps, "steps", base.max_events)
+    t_end = None if t_end is None else _real(t_end, "t_end (end time, s)")
+    sample_dt = _real(sample_dt, "sample_dt (s)")
+    rtol = base.rtol if rtol is None else _real(rtol, "rtol")
+    atol = base.atol if atol is None else _real(atol, "atol")
+    max_step_time = None if max_step_time is None else _real(max_step_time, "max_step_time (s)")
+    budget = _count(budget, "budget (bytes)", 0) or RECORD_BUDGET
     if t_end is not None and not (t_end > 0 and math.isfinite(t_end)):
         raise StateError(f"end time must be positive and finite, got {t_end}")
     if not (sample_dt >= 0 and math.isfinite(sample_dt)):
         raise StateError(f"sample_dt must be a finite number ≥ 0 s, got {sample_dt}")
-    if steps is None and t_end is None:
-        t_end = 10.0
-    base = options or Options()
-    rtol = base.rtol if rtol is None else rtol
-    atol = base.atol if atol is None else atol
     for name, v in (("rtol", rtol), ("atol", atol)):
         if not (v > 0 and math.isfinite(v)):
             raise StateError(f"{name} must be a positive number, got {v}")
+    k = build(system)
+    p = parameter_vector(k, params, system)
+    mi, x = initial_state(system, k, x0, mode)
+    if steps is None and t_end is None:
+        t_end = 10.0
     mst = max_step_time if max_step_time is not None else system.max_step_time
     opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=mst,
                                method=base.method if method is None else method)
@@ -145,6 +165,30 @@ def simulate(
         traj.x = np.vstack([x_start, x_end])
     traj.system = system
     return traj
+
+
+def _real(value: Any, what: str) -> float:
+    """``value`` as a float if it is a real number (not a bool, not text), else :class:`StateError`."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise StateError(f"{what} must be a number, got {value!r}")
+    return float(value)
+
+
+def _count(value: Any, what: str, most: int) -> int | None:
+    """``value`` as an int ≥ 1 (and ≤ ``most`` unless ``most`` is 0) if it is an integer (not a
+    bool, not a float or text), else :class:`StateError`; ``None`` stays ``None``."""
+    if value is None:
+        return None
+    try:
+        n = operator.index(value) if not isinstance(value, bool) else None
+    except TypeError:
+        n = None
+    if n is None:
+        raise StateError(f"{what} must be an integer, got {value!r}")
+    if n < 1 or n > (most or 2**62):  # the compiled loop counts in 64 bits
+        bound = f" and at most {most} (Options.max_events)" if most else f" and at most {2**62}"
+        raise StateError(f"{what} must be at least 1{bound}, got {n}")
+    return n
 
 
 def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
