@@ -47,6 +47,7 @@ class Defs:
 
     def __init__(self) -> None:
         self._defs: dict[sp.Symbol, sp.Expr] = {}
+        self._names: dict[sp.Expr, sp.Symbol] = {}
         self._done: dict[sp.Basic, sp.Basic] = {}
 
     def __call__(self, e: Any) -> sp.Expr:
@@ -54,8 +55,12 @@ class Defs:
         if e.is_Atom or isinstance(e, sp.Function) or (
                 e.is_Mul and len(e.args) == 2 and e.args[0].is_Number and e.args[1].is_Atom):
             return e
-        s = sp.Dummy(f"k{len(self._defs)}")
-        self._defs[s] = e
+        # an expression defined before keeps its name: recursions meet the same quantity often
+        # (a point on a body and its centre of mass, M's and h's shared kinematics, a second derive)
+        s = self._names.get(e)
+        if s is None:
+            s = self._names[e] = sp.Dummy(f"k{len(self._defs)}")
+            self._defs[s] = e
         return s
 
     def vec(self, m: sp.Matrix) -> sp.Matrix:
@@ -304,6 +309,35 @@ class RigidTree:
                for b in self.bodies]
         self._energies[key] = d.expand(sp.Add(*out))
         return self._energies[key]
+
+    # ------------------------------------------------------------------ joint transforms
+    def local_transform(self, b: Body) -> tuple[sp.Matrix, sp.Matrix]:
+        """``(E, r)``: body ``b``'s frame in its parent's (or the world's), ``x_parent = E x_b + r``
+        — the joint origin, the joint motion by ``qᵢ``, then any fixed offset after the motion."""
+        j = b.joint
+        Ro = _mat3(j.rotation) if j.rotation is not None else _mat3(rpy_matrix(j.rpy))
+        E, r = Ro, _vec(j.xyz)
+        if j.type == "prismatic":
+            r = r + _matmul(Ro, _vec(j.axis) * b.coordinate)
+        elif j.type != "fixed":
+            E = _matmul(Ro, _rotation(_vec(j.axis), sp.cos(b.coordinate), sp.sin(b.coordinate)))
+        if j.post_xyz is not None:
+            r = r + _matmul(E, _vec(j.post_xyz))
+        if j.post_rotation is not None:
+            E = _matmul(E, _mat3(j.post_rotation))
+        return E, r
+
+    def local_subspace(self, b: Body) -> tuple[sp.Matrix, sp.Matrix]:
+        """The motion subspace of ``b``'s joint in ``b``'s own frame, ``(angular, linear at the
+        origin)`` per unit of q̇ᵢ — constant: ``(a, o × a)`` for a revolute joint about the axis
+        ``a`` through the point ``o``, ``(0, a)`` for a prismatic one."""
+        j = b.joint
+        Pt = _mat3(j.post_rotation).T if j.post_rotation is not None else sp.eye(3)
+        a = _matmul(Pt, _vec(j.axis))
+        if j.type == "prismatic":
+            return sp.zeros(3, 1), a
+        o = -_matmul(Pt, _vec(j.post_xyz or (0, 0, 0)))   # the joint's origin, seen from the body
+        return a, o.cross(a)
 
     # ------------------------------------------------------------------ kinematics
     def _kinematics(self, b: Body) -> None:
