@@ -28,9 +28,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..modelling.tree import Body, Defs, RigidTree, _matmul
-
-_ZERO = sp.Integer(0)
+from ..modelling.tree import Defs, RigidTree, _cross, _dot, _matmul
 
 
 class _Spatial:
@@ -88,13 +86,6 @@ class _Inertia:
     def __init__(self, m: sp.Expr, h: sp.Matrix, I: sp.Matrix) -> None:
         self.m, self.h, self.I = m, h, I
 
-    @classmethod
-    def of(cls, b: Body, d: Defs) -> _Inertia:
-        c, m = b.com, b.mass
-        cc = _dot(c, c)
-        I = sp.Matrix(3, 3, lambda i, j: b.inertia[i, j] + m * ((cc if i == j else 0) - c[i] * c[j]))
-        return cls(m, d.vec(c * m), d.vec(I))
-
     def to_parent(self, X: _Transform, d: Defs) -> _Inertia:
         """``Xᵀ I X``: the same inertia about the parent's origin, in the parent's axes.
 
@@ -120,17 +111,6 @@ class _Inertia:
         return _Spatial(d.vec(_matmul(self.I, s.w) + _cross(self.h, s.v)), d.vec(s.v * self.m - _cross(self.h, s.w)))
 
 
-def _dot(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
-    return sp.Add(*[x * y for x, y in zip(a, b) if x != 0 and y != 0])
-
-
-def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
-    def term(i: int, j: int) -> sp.Expr:
-        return a[i] * b[j] if a[i] != 0 and b[j] != 0 else _ZERO
-
-    return sp.Matrix([term(1, 2) - term(2, 1), term(2, 0) - term(0, 2), term(0, 1) - term(1, 0)])
-
-
 def tree_dynamics(tree: RigidTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
     """``M`` (n × n, over all model coordinates) and ``h`` (n × 1) of the tree's bodies, in the
     intermediate symbols of ``tree.defs`` (``tree.defs.expand`` gives them in q, q̇, parameters)."""
@@ -144,9 +124,8 @@ def tree_dynamics(tree: RigidTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Ma
         E, r = tree.local_transform(b)
         X[b.name] = _Transform(d.vec(E), d.vec(r))
         if b.moving:
-            w, v = tree.local_subspace(b)
-            S[b.name] = _Spatial(w, v)
-    inertia = {b.name: _Inertia.of(b, d) for b in bodies}
+            S[b.name] = _Spatial(*tree.local_subspace(b))
+    inertia = {b.name: _Inertia(*tree.body_inertia(b)) for b in bodies}
 
     # ---- CRBA: composite inertias from the leaves (bodies are in topological order)
     comp = dict(inertia)
@@ -167,24 +146,19 @@ def tree_dynamics(tree: RigidTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Ma
                 M[i, a.index] = M[a.index, i] = d(S[a.name].dot(F))
             c, a = a, a.parent
 
-    # ---- RNEA with q̈ = 0: velocities and accelerations out, forces back
+    # ---- RNEA with q̈ = 0: velocities (the tree's, shared with its kinetic energy) and
+    # accelerations out, forces back; gravity enters as an upward acceleration of the base
     zero = sp.zeros(3, 1)
-    V: dict[str, _Spatial] = {}
+    vel = tree.body_velocities()
     A: dict[str, _Spatial] = {}
     F: dict[str, _Spatial] = {}
     for b in bodies:
         Xb = X[b.name]
-        if b.parent is not None:
-            v0, a0 = Xb.motion(V[b.parent.name], d), Xb.motion(A[b.parent.name], d)
-        else:  # the base: at rest, accelerating upwards (gravity as a base acceleration)
-            v0, a0 = _Spatial(zero, zero), Xb.motion(_Spatial(zero, -gravity), d)
-        if b.moving:
-            sq = S[b.name].scale(model.dot(b.coordinate)).named(d)
-            vb = (v0 + sq).named(d)
-            ab = (a0 + vb.cross_motion(sq)).named(d)
-        else:
-            vb, ab = v0, a0
-        V[b.name], A[b.name] = vb, ab
+        a0 = Xb.motion(A[b.parent.name] if b.parent is not None else _Spatial(zero, -gravity), d)
+        w, v, sw, sv = vel[b.name]
+        vb = _Spatial(w, v)
+        ab = (a0 + vb.cross_motion(_Spatial(sw, sv))).named(d) if b.moving else a0
+        A[b.name] = ab
         I = inertia[b.name]
         F[b.name] = (I.apply(ab, d) + vb.cross_force(I.apply(vb, d))).named(d)
     h = sp.zeros(n, 1)

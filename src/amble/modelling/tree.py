@@ -285,28 +285,75 @@ class RigidTree:
         return [b for b in self.bodies if b.moving]
 
     def kinetic(self) -> sp.Expr:
-        """Kinetic energy of the bodies from their velocities: Σ ½ (m |v_c|² + ωᵀ R I Rᵀ ω)."""
+        """Kinetic energy of the bodies from their body-frame velocities ``(ω, v)`` (``v`` of the
+        body's origin): Σ ½ (ωᵀ I_o ω + m |v|² + 2 m c·(v × ω)), ``I_o`` about the origin."""
         key = ("K", len(self.bodies))
         if key in self._energies:
             return self._energies[key]
         d = self.defs
         out = []
+        vel = self.body_velocities()
         for b in self.bodies:
-            vc = d.vec(b.vel + b.omega.cross(d.vec(_matmul(b.R, b.com))))
-            wb = d.vec(_matmul(b.R.T, b.omega))
-            iw = d.vec(_matmul(b.inertia, wb))
-            out.append(d(b.mass * d((vc.T * vc)[0, 0]) + d((wb.T * iw)[0, 0])))
+            m, h, I = self.body_inertia(b)
+            w, v = vel[b.name][:2]
+            e = _dot(w, d.vec(_matmul(I, w))) + m * _dot(v, v) + 2 * _dot(h, d.vec(_cross(v, w)))
+            if e != 0:
+                out.append(d(e))
         self._energies[key] = d.expand(sp.Add(*out) / 2)
         return self._energies[key]
 
+    def body_inertia(self, b: Body) -> tuple[sp.Expr, sp.Matrix, sp.Matrix]:
+        """Mass, first moment ``m c`` and rotational inertia ``I_c + m (|c|² 1 − c cᵀ)`` of ``b``
+        about its frame's origin, in its axes (constants of the model)."""
+        d, c, m = self.defs, b.com, b.mass
+        cc = _dot(c, c)
+        I = sp.Matrix(3, 3, lambda i, j: b.inertia[i, j] + m * ((cc if i == j else 0) - c[i] * c[j]))
+        return m, d.vec(c * m), d.vec(I)
+
+    def body_velocities(self) -> dict[str, tuple[sp.Matrix, ...]]:
+        """Spatial velocity of every body in its own frame, by recursion from the base:
+        ``(ω, v, ω_j, v_j)`` — angular velocity, velocity of the origin, and the joint's share
+        ``Sᵢ q̇ᵢ`` of both (zero for a fixed joint). Named intermediates of :attr:`defs`, which
+        the dynamics (:mod:`amble.derivation.tree`) reuse."""
+        key = ("vel", len(self.bodies))
+        if key in self._energies:
+            return self._energies[key]
+        d, out, zero = self.defs, {}, sp.zeros(3, 1)
+        for b in self.bodies:
+            E, r = (d.vec(x) for x in self.local_transform(b))
+            if b.parent is None:
+                w, v = zero, zero
+            else:
+                wp, vp = out[b.parent.name][:2]
+                w, v = d.vec(_matmul(E.T, wp)), d.vec(_matmul(E.T, vp + _cross(wp, r)))
+            sw = sv = zero
+            if b.moving:
+                qd = self.model.dot(b.coordinate)
+                a, o = self.local_subspace(b)
+                sw, sv = d.vec(a * qd), d.vec(o * qd)
+                w, v = d.vec(w + sw), d.vec(v + sv)
+            out[b.name] = (w, v, sw, sv)
+        self._energies[key] = out
+        return out
+
     def potential(self, gravity: sp.Matrix) -> sp.Expr:
-        """Gravitational potential energy of the bodies: Σ −m g·c."""
+        """Gravitational potential energy of the bodies, Σ −m g·c, by recursion in body frames:
+        with ``gᵢ = Eᵢᵀ g_parent`` (gravity in body i's axes) and ``zᵢ = z_parent + g_parent·rᵢ``
+        (g · the origin of body i), ``−m g·c = −m zᵢ − gᵢ·(m c)`` — three rotated components per
+        body instead of every body's world rotation."""
         key = ("V", len(self.bodies), tuple(gravity))
         if key in self._energies:
             return self._energies[key]
-        d = self.defs
-        out = [d(-b.mass * d(sp.Add(*[g * c for g, c in zip(gravity, d.vec(b.p + _matmul(b.R, b.com))) if g != 0])))
-               for b in self.bodies]
+        d, out = self.defs, []
+        gz: dict[str, tuple[sp.Matrix, sp.Expr]] = {}
+        for b in self.bodies:
+            E, r = (d.vec(x) for x in self.local_transform(b))
+            gp, zp = gz[b.parent.name] if b.parent is not None else (gravity, sp.Integer(0))
+            gz[b.name] = g, z = d.vec(_matmul(E.T, gp)), d(zp + _dot(gp, r))
+            m, h, _ = self.body_inertia(b)
+            e = -m * z - _dot(g, h)
+            if e != 0:
+                out.append(d(e))
         self._energies[key] = d.expand(sp.Add(*out))
         return self._energies[key]
 
@@ -381,6 +428,19 @@ def _matmul(A: sp.Matrix, B: sp.Matrix) -> sp.Matrix:
         for k in range(B.cols):
             out[i, k] = sp.Add(*[A[i, j] * B[j, k] for j in range(A.cols) if A[i, j] != 0 and B[j, k] != 0])
     return out
+
+
+def _dot(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
+    """Dot product that skips zero terms."""
+    return sp.Add(*[x * y for x, y in zip(a, b) if x != 0 and y != 0])
+
+
+def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
+    """Cross product that skips zero terms."""
+    def term(i: int, j: int) -> sp.Expr:
+        return a[i] * b[j] if a[i] != 0 and b[j] != 0 else sp.Integer(0)
+
+    return sp.Matrix([term(1, 2) - term(2, 1), term(2, 0) - term(0, 2), term(0, 1) - term(1, 0)])
 
 
 def _mul_add(A: sp.Matrix, x: sp.Matrix, y: sp.Matrix) -> sp.Matrix:
