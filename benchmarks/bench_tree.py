@@ -260,7 +260,7 @@ def run(quick: bool = False) -> Section:
         notes.append(f"URDF parser import (yourdfpy → trimesh, scipy.spatial), not in the build times: {pi:.2f} s")
     ct = next((r["rhs_ctypes_s"]["median"] - r["rhs_c_s"]["median"] for r in data.values() if r["n"] <= 2), None)
     if ct is not None:
-        notes.append(f"ctypes call overhead of `Kernels.rhs` (n = 2 chain, Python loop minus C loop): {ct * 1e6:.2f} µs")
+        notes.append(f"ctypes call overhead of `Kernels.rhs` (n = 2 chain, Python loop − C loop): {ct * 1e6:.2f} µs")
     pv = next((r["pin_version"] for r in data.values() if "pin_version" in r), None)
     if pv:
         notes.append(f"Pinocchio {pv}")

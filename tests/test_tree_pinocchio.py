@@ -85,3 +85,80 @@ def test_urdf_robot_matches_pinocchio(name):
 @pytest.mark.slow
 def test_humanoid30_matches_pinocchio():
     _compare("humanoid30")
+
+
+def _euler(yaw: float, pitch: float, roll: float) -> tuple[np.ndarray, ...]:
+    cz, sz, cy, sy, cx, sx = np.cos(yaw), np.sin(yaw), np.cos(pitch), np.sin(pitch), np.cos(roll), np.sin(roll)
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    return Rz, Ry, Rx
+
+
+def test_floating_base_matches_pinocchio():
+    """A floating base (x, y, z, yaw, pitch, roll) under the RABBIT URDF: M, h and q̈ equal
+    Pinocchio's with the same six joints as a composite root joint; M and h equal Pinocchio's
+    free-flyer (quaternion, body-frame velocity) mapped by the velocity Jacobian of the Euler
+    angles, ``M = Jᵀ M_ff J``, ``h = Jᵀ h_ff`` (at rest in orientation, where J̇ q̇ = 0)."""
+    from amble.modelling.tree import Joint
+
+    path = DATA / "rabbit.urdf"
+    model = Model.from_urdf(path, base_joint=Joint("floating"), base_coordinate="base")
+    names = [str(s) for s in model.q]
+    assert names[:6] == ["base_x", "base_y", "base_z", "base_yaw", "base_pitch", "base_roll"]
+    k = build(HybridSystem(model.name, model))
+    comp = pin.JointModelComposite()
+    for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
+              pin.JointModelRZ(), pin.JointModelRY(), pin.JointModelRX()):
+        comp.addJoint(j)
+    pm = pin.buildModelFromUrdf(str(path), comp)
+    idx = []
+    for s in names:
+        if s.startswith("base_"):
+            idx.append(names.index(s))
+        else:
+            idx.append(pm.joints[pm.getJointId(s)].idx_q)
+    assert sorted(idx) == list(range(pm.nq))
+    pd = pm.createData()
+    ff = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    fd = ff.createData()
+    rel = lambda a, b: np.abs(a - b).max() / np.abs(b).max()
+    rng = np.random.default_rng(5)
+    p = np.zeros(1)
+    n = len(names)
+    for _ in range(20):
+        q, v = rng.uniform(-1.2, 1.2, n), rng.uniform(-2.0, 2.0, n)
+        x = np.concatenate([q, v])
+        M, h, _ = k.dynamics(0, 0.0, x, p)
+        qdd = k.rhs(0, 0.0, x, p)[n:]
+        qp, vp = np.zeros(n), np.zeros(n)
+        qp[idx], vp[idx] = q, v
+        Mp = pin.crba(pm, pd, qp)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        assert rel(M, Mp[np.ix_(idx, idx)]) <= 1e-12
+        assert rel(h, pin.rnea(pm, pd, qp, vp, np.zeros(n))[idx]) <= 1e-12
+        assert rel(qdd, pin.aba(pm, pd, qp, vp, np.zeros(n))[idx]) <= 1e-12
+        # free flyer: q = (p, quaternion), v = (Rᵀ ṗ, ω in the base frame)
+        v[3:6] = 0.0  # base orientation at rest: J̇ q̇ = 0
+        x = np.concatenate([q, v])
+        M, h, _ = k.dynamics(0, 0.0, x, p)
+        Rz, Ry, Rx = _euler(*q[3:6])
+        R = Rz @ Ry @ Rx
+        J = np.eye(n)
+        J[0:3, 0:3] = R.T
+        J[3:6, 3] = R.T @ [0, 0, 1]
+        J[3:6, 4] = Rx.T @ [0, 1, 0]
+        J[3:6, 5] = [1, 0, 0]
+        jq = [ff.joints[ff.getJointId(s)].idx_q for s in names[6:]]
+        jv = [ff.joints[ff.getJointId(s)].idx_v for s in names[6:]]
+        qf = np.zeros(ff.nq)
+        qf[0:3], qf[3:7] = q[0:3], pin.Quaternion(R).coeffs()
+        qf[jq] = q[6:]
+        vf = np.zeros(ff.nv)
+        order = [0, 1, 2, 3, 4, 5, *jv]  # free-flyer velocity, then the joints in amble's order
+        vf[order] = J @ v
+        Mf = pin.crba(ff, fd, qf)
+        Mf = (np.triu(Mf) + np.triu(Mf, 1).T)[np.ix_(order, order)]
+        hf = pin.rnea(ff, fd, qf, vf, np.zeros(ff.nv))[order]
+        assert rel(M, J.T @ Mf @ J) <= 1e-12
+        assert rel(h, J.T @ hf) <= 1e-12

@@ -31,78 +31,16 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
-from .dag import fold
+from .defs import Defs
 
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
-
-
-class Defs:
-    """Intermediate quantities of a recursion: each non-trivial expression is named by a fresh
-    symbol, so every step works on small expressions (sympy's cost grows with their size).
-
-    :meth:`expand` turns an expression of these symbols back into one of q, q̇ and parameters,
-    as a DAG: each definition is rebuilt once, unevaluated (no flattening, no distribution of
-    numeric factors), and shared by every use — common subexpressions for code generation.
-    """
-
-    def __init__(self) -> None:
-        self._defs: dict[sp.Symbol, sp.Expr] = {}
-        self._names: dict[sp.Expr, sp.Symbol] = {}
-        self._done: dict[sp.Basic, sp.Basic] = {}
-
-    def __call__(self, e: Any) -> sp.Expr:
-        e = sp.sympify(e)
-        if e.is_Atom or isinstance(e, sp.Function) or (
-                e.is_Mul and len(e.args) == 2 and e.args[0].is_Number and e.args[1].is_Atom):
-            return e
-        # an expression defined before keeps its name: recursions meet the same quantity often
-        # (a point on a body and its centre of mass, M's and h's shared kinematics, a second derive)
-        s = self._names.get(e)
-        if s is None:
-            s = self._names[e] = sp.Dummy(f"k{len(self._defs)}")
-            self._defs[s] = e
-        return s
-
-    def vec(self, m: sp.Matrix) -> sp.Matrix:
-        return m.applyfunc(self)
-
-    def needed(self, exprs: Any) -> list[tuple[sp.Symbol, sp.Expr]]:
-        """The definitions that ``exprs`` use, directly or not, in an order where each comes
-        after those it uses."""
-        used: set[sp.Symbol] = set()
-        stack = [e for e in exprs]
-        seen: set[sp.Basic] = set()
-        while stack:
-            x = sp.sympify(stack.pop())
-            if x in seen:
-                continue
-            seen.add(x)
-            if isinstance(x, sp.Dummy) and x in self._defs:
-                used.add(x)
-                stack.append(self._defs[x])
-            elif not x.is_Atom:
-                stack.extend(x.args)
-        return [(s, e) for s, e in self._defs.items() if s in used]
-
-    def expand(self, e: Any) -> Any:
-        """``e`` (an expression or matrix of the defined symbols) in q, q̇ and parameters."""
-        if isinstance(e, sp.MatrixBase):
-            return e.applyfunc(self.expand)
-        defs = self._defs
-
-        def children(x: sp.Basic) -> Sequence[sp.Basic]:
-            if isinstance(x, sp.Dummy) and x in defs:
-                return (defs[x],)  # a defined symbol stands for its definition
-            return () if x.is_Atom else x.args
-
-        def combine(x: sp.Basic, args: list[Any]) -> Any:
-            if isinstance(x, sp.Dummy) and x in defs:
-                return args[0]
-            if x.is_Atom:
-                return x
-            return x.func(*args, evaluate=False) if isinstance(x, (sp.Add, sp.Mul)) else x.func(*args)
-
-        return fold(sp.sympify(e), children, combine, self._done)
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "spherical", "floating")
+#: the one-axis joints a spherical or floating joint stands for (suffix of the coordinate, type, axis):
+#: translations along the joint frame's x, y, z, then the rotation ``Rz(yaw) Ry(pitch) Rx(roll)``
+_COMPOSITE = {
+    "spherical": (("yaw", "revolute", (0, 0, 1)), ("pitch", "revolute", (0, 1, 0)), ("roll", "revolute", (1, 0, 0))),
+    "floating": (("x", "prismatic", (1, 0, 0)), ("y", "prismatic", (0, 1, 0)), ("z", "prismatic", (0, 0, 1)),
+                 ("yaw", "revolute", (0, 0, 1)), ("pitch", "revolute", (0, 1, 0)), ("roll", "revolute", (1, 0, 0))),
+}
 
 
 def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
@@ -226,6 +164,12 @@ class RigidTree:
         A moving joint declares the model coordinate ``coordinate`` (default: the body's name),
         in rad for a revolute joint and m for a prismatic one. The centre of mass becomes the
         model point ``name`` carrying ``mass``.
+
+        A ``spherical`` joint (3 coordinates ``<coordinate>_yaw``, ``_pitch``, ``_roll``: the
+        rotation ``Rz(yaw) Ry(pitch) Rx(roll)`` of the joint frame) and a ``floating`` one (6:
+        ``<coordinate>_x``, ``_y``, ``_z`` along the joint frame's axes, then yaw, pitch, roll)
+        are chains of one-axis joints through massless frames — Euler angles, singular at
+        pitch = ±π/2 (gimbal lock), which a walker's base does not reach.
         """
         joint = joint or Joint()
         m = self.model
@@ -234,6 +178,26 @@ class RigidTree:
         if joint.type not in JOINT_TYPES:
             raise ModelError(f"model {m.name!r}: joint of body {name!r} has unknown type {joint.type!r} "
                              f"(known: {', '.join(JOINT_TYPES)})")
+        if joint.type in _COMPOSITE:
+            if joint.post_xyz is not None or joint.post_rotation is not None:
+                raise ModelError(f"model {m.name!r}: a {joint.type} joint (body {name!r}) cannot be reversed")
+            cname = coordinate or name
+            *inner, last = _COMPOSITE[joint.type]
+            for k, (suffix, kind, axis) in enumerate(inner):
+                first = dict(xyz=joint.xyz, rpy=joint.rpy, rotation=joint.rotation) if k == 0 else {}
+                self._add(f"{name}.{suffix}", parent, Joint(kind, axis=axis, **first), 0, (0, 0, 0),
+                          ((0, 0, 0),) * 3, f"{cname}_{suffix}", None, internal=True)
+                parent = f"{name}.{suffix}"
+            suffix, kind, axis = last
+            joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper)
+            coordinate = f"{cname}_{suffix}"
+        return self._add(name, parent, joint, mass, com, inertia, coordinate, unit)
+
+    def _add(self, name: str, parent: str | None, joint: Joint, mass: Any, com: Sequence[Any], inertia: Any,
+             coordinate: str | None, unit: str | None, internal: bool = False) -> Body:
+        """A body of a one-axis (or fixed) joint; ``internal``: a massless frame of a composite
+        joint, which is not a model point."""
+        m = self.model
         par = None
         if parent is not None:
             if parent not in self._by_name:
@@ -257,13 +221,17 @@ class RigidTree:
         self._kinematics(b)
         self.bodies.append(b)
         self._by_name[name] = b
+        if internal:
+            return b
         r = self.defs.vec(_matmul(b.R, b.com))
         m.point(name, self.defs.expand(b.p + r))
         self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
         self.com_points[name] = b
         if mass_e != 0:
             m.mass(name, mass_e)
-        if par is not None and par.name in m.points:
+        while par is not None and par.name not in m.points:  # past a composite joint's frames
+            par = par.parent
+        if par is not None:
             m.link(par.name, name)
         return b
 
