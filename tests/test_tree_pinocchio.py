@@ -162,3 +162,46 @@ def test_floating_base_matches_pinocchio():
         hf = pin.rnea(ff, fd, qf, vf, np.zeros(ff.nv))[order]
         assert rel(M, J.T @ Mf @ J) <= 1e-12
         assert rel(h, J.T @ hf) <= 1e-12
+
+
+def test_constrained_tree_matches_pinocchio(tmp_path):
+    """``constrained()`` of a tree model: the RABBIT with the left knee locked straight and the
+    right knee driven by the left hip, ``right_knee = 0.5 sin(left_hip)``. Truth: Pinocchio on the
+    URDF with the left knee made a fixed joint, projected on the remaining coordinates,
+    ``M = Jᵀ M_p J`` and ``h = Jᵀ (h_p + M_p J̇ q̇)``."""
+    import sympy as sp
+
+    path = DATA / "rabbit.urdf"
+    full = Model.from_urdf(path)
+    a = full.symbol("left_hip")
+    model = full.constrained("rabbit-locked", {full.symbol("left_knee"): 0,
+                                               full.symbol("right_knee"): sp.sin(a) / 2})
+    assert [str(s) for s in model.q] == ["left_hip", "right_hip"]
+    k = build(HybridSystem(model.name, model))
+    root = ET.parse(path).getroot()
+    root.find("joint[@name='left_knee']").set("type", "fixed")
+    edited = tmp_path / "locked.urdf"
+    ET.ElementTree(root).write(edited)
+    pm = pin.buildModelFromUrdf(str(edited))
+    pd = pm.createData()
+    iq = {s: pm.joints[pm.getJointId(s)].idx_q for s in ("left_hip", "right_hip", "right_knee")}
+    rel = lambda x, y: np.abs(x - y).max() / np.abs(y).max()
+    rng = np.random.default_rng(3)
+    for _ in range(30):
+        (th, ps), (thd, psd) = rng.uniform(-1.5, 1.5, 2), rng.uniform(-2.0, 2.0, 2)
+        J = np.zeros((pm.nv, 2))
+        J[iq["left_hip"], 0], J[iq["right_hip"], 1], J[iq["right_knee"], 0] = 1.0, 1.0, np.cos(th) / 2
+        qp = np.zeros(pm.nq)
+        qp[iq["left_hip"]], qp[iq["right_hip"]], qp[iq["right_knee"]] = th, ps, np.sin(th) / 2
+        vp = J @ [thd, psd]
+        jdqd = np.zeros(pm.nv)
+        jdqd[iq["right_knee"]] = -np.sin(th) / 2 * thd**2
+        Mp = pin.crba(pm, pd, qp)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        hp = pin.rnea(pm, pd, qp, vp, np.zeros(pm.nv))
+        x = np.array([th, ps, thd, psd])
+        M, h, _ = k.dynamics(0, 0.0, x, np.zeros(1))
+        assert rel(M, J.T @ Mp @ J) <= 1e-12
+        assert rel(h, J.T @ (hp + Mp @ jdqd)) <= 1e-12
+        qdd = k.rhs(0, 0.0, x, np.zeros(1))[2:]
+        assert rel(qdd, np.linalg.solve(J.T @ Mp @ J, -J.T @ (hp + Mp @ jdqd))) <= 1e-11

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..modelling.constrained_tree import ConstrainedTree
 from ..modelling.tree import Defs, RigidTree, _cross, _dot, _matmul
 
 
@@ -111,9 +112,11 @@ class _Inertia:
         return _Spatial(d.vec(_matmul(self.I, s.w) + _cross(self.h, s.v)), d.vec(s.v * self.m - _cross(self.h, s.w)))
 
 
-def tree_dynamics(tree: RigidTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
+def tree_dynamics(tree: RigidTree | ConstrainedTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
     """``M`` (n × n, over all model coordinates) and ``h`` (n × 1) of the tree's bodies, in the
     intermediate symbols of ``tree.defs`` (``tree.defs.expand`` gives them in q, q̇, parameters)."""
+    if isinstance(tree, ConstrainedTree):
+        return _projected(tree, gravity)
     model = tree.model
     n = len(model.q)
     bodies = tree.bodies
@@ -168,4 +171,24 @@ def tree_dynamics(tree: RigidTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Ma
             h[b.index] = d(S[b.name].dot(f))
         if b.parent is not None:
             F[b.parent.name] = (F[b.parent.name] + X[b.name].force(f, d)).named(d)
+    return M, h
+
+
+def _projected(tree: ConstrainedTree, gravity: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
+    """A constrained tree's ``M = Jᵀ M_full J`` and ``h = Jᵀ (h_full + M_full J̇ q̇)`` from the source
+    tree's equations, in the source's intermediate symbols with the eliminated coordinates replaced."""
+    Mf, hf = (m.xreplace(tree.substitutions) for m in tree_dynamics(tree.source, gravity))
+    d = tree.sync()
+    J, jdqd = tree.jacobian()
+    nf, n = J.shape
+    nz = lambda e: e != 0  # noqa: E731
+    MJ = [[d(sp.Add(*[Mf[k, l] * J[l, j] for l in range(nf) if nz(J[l, j]) and nz(Mf[k, l])])) for j in range(n)]
+          for k in range(nf)]
+    hb = [d(hf[k] + sp.Add(*[Mf[k, l] * jdqd[l] for l in range(nf) if nz(jdqd[l]) and nz(Mf[k, l])]))
+          for k in range(nf)]
+    M, h = sp.zeros(n, n), sp.zeros(n, 1)
+    for i in range(n):
+        for j in range(i, n):
+            M[i, j] = M[j, i] = d(sp.Add(*[J[k, i] * MJ[k][j] for k in range(nf) if nz(J[k, i]) and nz(MJ[k][j])]))
+        h[i] = d(sp.Add(*[J[k, i] * hb[k] for k in range(nf) if nz(J[k, i]) and nz(hb[k])]))
     return M, h

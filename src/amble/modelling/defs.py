@@ -79,3 +79,10 @@ class Defs:
             return x.func(*args, evaluate=False) if isinstance(x, (sp.Add, sp.Mul)) else x.func(*args)
 
         return fold(sp.sympify(e), children, combine, self._done)
+
+    def substituted(self, mapping: dict) -> Defs:
+        """The same names, each defined with the symbols of ``mapping`` replaced (a model with
+        some coordinates tied to others: the definitions are small, so each is replaced alone)."""
+        out = Defs()
+        out._defs = {s: e.xreplace(mapping) for s, e in self._defs.items()}
+        return out

@@ -24,6 +24,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
+from .constrained_tree import ConstrainedTree
 from .dag import dag_diff, free_symbols
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
@@ -64,7 +65,7 @@ class Model(Names):
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
-        self.tree: RigidTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
+        self.tree: RigidTree | ConstrainedTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
 
     def dt(self, expr: Any) -> Any:
         """Total time derivative of an expression (or vector) of q and t, by the chain rule
@@ -287,9 +288,9 @@ class Model(Names):
 
         Positions, energies and masses are substituted; generalized forces are mapped by virtual
         work, ``Γ_new = (∂q/∂q_new)ᵀ Γ``, so a torque declared once acts correctly in both modes.
+        A rigid-body tree stays one (:mod:`amble.modelling.constrained_tree`): its equations are
+        the source tree's, projected.
         """
-        if self.tree is not None:  # declare the locked joint fixed in a second model instead
-            raise ModelError(f"model {self.name!r}: constrained() of a rigid-body tree is not supported")
         subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
         for k in subs:
             if k not in self.q:
@@ -306,18 +307,23 @@ class Model(Names):
                 raise ModelError(f"model {self.name!r}: {qi} = {v} uses {', '.join(map(str, bad))}")
         vsubs = dict(subs)
         vsubs.update({self.dot(qi): out.dt(v) for qi, v in subs.items()})
-        out.points = {n: p.subs(subs) for n, p in self.points.items()}
+        if self.tree is not None:  # shared expression graphs: each shared part substituted once
+            out.tree = ConstrainedTree(self.tree, out, vsubs)
+            put = out.tree.replace
+        else:
+            put = lambda e: e.subs(vsubs)  # noqa: E731
+        out.points = {n: put(p) for n, p in self.points.items()}
         out.masses = dict(self.masses)
         out.links = list(self.links)
-        out._k_terms = [e.subs(vsubs) for e in self._k_terms]
-        out._k_added = [e.subs(vsubs) for e in self._k_added]
-        out._v_terms = [e.subs(subs) for e in self._v_terms]
+        out._k_terms = [put(e) for e in self._k_terms]
+        out._k_added = [put(e) for e in self._k_added]
+        out._v_terms = [put(e) for e in self._v_terms]
         for attr in ("_k_override", "_v_override", "_l_override"):
             e = getattr(self, attr)
-            setattr(out, attr, None if e is None else e.subs(vsubs))
+            setattr(out, attr, None if e is None else put(e))
         full = sp.Matrix([subs.get(qi, qi) for qi in self.q])
         jac = full.jacobian(out.q)
-        out._forces = [jac.T * f.subs(vsubs) for f in self._forces]
+        out._forces = [jac.T * put(f) for f in self._forces]
         out._g, out._g_dir = self._g, self._g_dir
         return out
 
