@@ -205,3 +205,35 @@ def test_constrained_tree_matches_pinocchio(tmp_path):
         assert rel(h, J.T @ (hp + Mp @ jdqd)) <= 1e-12
         qdd = k.rhs(0, 0.0, x, np.zeros(1))[2:]
         assert rel(qdd, np.linalg.solve(J.T @ Mp @ J, -J.T @ (hp + Mp @ jdqd))) <= 1e-11
+
+
+def test_spherical_joint_matches_pinocchio():
+    """A body on a spherical joint (yaw, pitch, roll) below a fixed offset, under gravity: M, h
+    and q̈ equal Pinocchio's for the same rotations as a composite joint (RZ, RY, RX)."""
+    from amble.modelling.tree import Joint
+
+    mass, com = 2.5, (0.05, -0.02, -0.4)
+    inertia = np.array([[0.03, 0.002, -0.001], [0.002, 0.05, 0.004], [-0.001, 0.004, 0.02]])
+    model = Model("ball", dims=3)
+    model.gravity(9.81)
+    model.rigid_tree().body("bob", joint=Joint("spherical", xyz=(0.1, 0.0, 1.0)), mass=mass, com=com,
+                            inertia=inertia, coordinate="ball")
+    assert [str(s) for s in model.q] == ["ball_yaw", "ball_pitch", "ball_roll"]
+    k = build(HybridSystem(model.name, model))
+    pm = pin.Model()
+    comp = pin.JointModelComposite()
+    for j in (pin.JointModelRZ(), pin.JointModelRY(), pin.JointModelRX()):
+        comp.addJoint(j)
+    jid = pm.addJoint(0, comp, pin.SE3(np.eye(3), np.array([0.1, 0.0, 1.0])), "ball")
+    pm.appendBodyToJoint(jid, pin.Inertia(mass, np.array(com), inertia), pin.SE3.Identity())
+    pd = pm.createData()
+    rel = lambda a, b: np.abs(a - b).max() / np.abs(b).max()
+    rng = np.random.default_rng(11)
+    for _ in range(20):
+        q, v = rng.uniform(-1.2, 1.2, 3), rng.uniform(-2.0, 2.0, 3)
+        x = np.concatenate([q, v])
+        M, h, _ = k.dynamics(0, 0.0, x, np.zeros(1))
+        Mp = pin.crba(pm, pd, q)
+        assert rel(M, np.triu(Mp) + np.triu(Mp, 1).T) <= 1e-12
+        assert rel(h, pin.rnea(pm, pd, q, v, np.zeros(3))) <= 1e-12
+        assert rel(k.rhs(0, 0.0, x, np.zeros(1))[3:], pin.aba(pm, pd, q, v, np.zeros(3))) <= 1e-12
