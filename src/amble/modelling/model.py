@@ -86,13 +86,20 @@ class Model(Names):
 
     def diff(self, expr: Any, symbol: sp.Symbol) -> sp.Expr:
         """``∂expr/∂symbol`` (a tree model's shared subexpressions visited once: ``dag_diff``)."""
-        return sp.diff(expr, symbol) if self.tree is None else dag_diff(expr, symbol)
+        return sp.diff(expr, symbol) if self.tree is None else dag_diff(expr, symbol, self._dag_memo(symbol))
 
     def jacobian(self, expr: Any) -> sp.Matrix:
         """``∂expr/∂q`` of a vector expression (e.g. a point's position), one column per coordinate."""
         v = sp.Matrix(expr)
         return v.jacobian(self.q) if self.tree is None else sp.Matrix(
-            v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j]))
+            v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j], self._dag_memo(self.q[j])))
+
+    def _dag_memo(self, symbol: sp.Symbol) -> dict:
+        # one memo per symbol for the model's life: the points of a tree share their parents'
+        # kinematics, so each shared part is differentiated once for all of them (and the
+        # derivatives share as the positions do)
+        memos = self.__dict__.setdefault("_dag_memos", {})
+        return memos.setdefault(symbol, {})
 
     # ------------------------------------------------------------------ geometry
     def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
