@@ -12,6 +12,25 @@ from sympy.core.function import AppliedUndef
 from ..errors import ModelError
 
 
+_BAD = frozenset((sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I))
+
+
+def _distinct_nodes(e: sp.Basic) -> list[sp.Basic]:
+    """Every distinct subexpression of ``e``, each once: a rigid-body tree's positions share
+    their parents' at every level, and sympy's ``atoms`` and ``has`` walk a shared part again at
+    every use (exponential in the depth of the tree)."""
+    seen: set[int] = set()
+    out, stack = [], [e]
+    while stack:
+        x = stack.pop()
+        if id(x) in seen:
+            continue
+        seen.add(id(x))
+        out.append(x)
+        stack.extend(x.args)
+    return out
+
+
 def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
     """``value`` as a sympy expression fit for compiled code, or a :class:`ModelError` naming
     ``what``: no unparsable text, no undefined functions, no infinite, undefined or complex
@@ -22,10 +41,11 @@ def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
         raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
     if not isinstance(e, sp.Expr):
         raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
-    undefined = sorted(str(f.func) for f in e.atoms(AppliedUndef))
+    nodes = _distinct_nodes(e)
+    undefined = sorted({str(f.func) for f in nodes if isinstance(f, AppliedUndef)})
     if undefined:
         raise ModelError(f"model {model!r}: {what} uses undefined function(s) {', '.join(undefined)}")
-    if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
+    if any(x in _BAD for x in nodes if x.is_Atom):
         raise ModelError(f"model {model!r}: {what} contains an infinite, undefined or complex value: {e}")
     return e
 
