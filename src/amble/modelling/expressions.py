@@ -11,7 +11,6 @@ from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
 
-
 _BAD = frozenset((sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I))
 
 
