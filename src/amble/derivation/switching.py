@@ -42,12 +42,22 @@ def switching_surfaces(exprs: Iterable[sp.Expr], variables: Iterable[sp.Symbol])
     varset = set(variables)
     found: list[sp.Expr] = []
     seen: set[sp.Expr] = set()
+    # Each distinct subexpression is visited once: the equations of a rigid-body tree are DAGs
+    # whose shared parts a plain preorder traversal would walk again at every use (exponential
+    # in the depth of the tree). The order stays preorder, so the surfaces' order is unchanged.
+    visited: set[sp.Basic] = set()
     for e in exprs:
-        e = sp.sympify(e)
-        for node in sp.preorder_traversal(e):
+        stack = [sp.sympify(e)]
+        while stack:
+            node = stack.pop()
+            if node in visited:
+                continue
+            visited.add(node)
             for s in _surfaces_of(node):
                 if not (s.free_symbols & varset) or s in seen or -s in seen:
                     continue
                 seen.add(s)
                 found.append(s)
+            if not node.is_Atom:
+                stack.extend(reversed(node.args))
     return found

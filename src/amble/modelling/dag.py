@@ -115,3 +115,23 @@ def dag_srepr(obj: Any) -> str:
 
     top = walk(obj)
     return top + "|" + ";".join(out)
+
+
+def dag_subs(expr: Any, mapping: dict, memo: dict | None = None) -> Any:
+    """``expr`` (an expression or matrix) with the symbols of ``mapping`` replaced, visiting each
+    shared subexpression once and rebuilding it once (so the result shares as ``expr`` does;
+    sympy's ``subs`` and ``xreplace`` rebuild a shared part at every use). ``memo`` may be shared
+    between calls on expressions with common parts."""
+    memo = {} if memo is None else memo
+    if isinstance(expr, sp.MatrixBase):
+        return expr.applyfunc(lambda e: dag_subs(e, mapping, memo))
+
+    def children(e: sp.Basic) -> Sequence[sp.Basic]:
+        return () if e.is_Atom else e.args
+
+    def combine(e: sp.Basic, args: list[Any]) -> Any:
+        if e.is_Atom:
+            return mapping.get(e, e)
+        return e if all(a is b for a, b in zip(args, e.args)) else e.func(*args)
+
+    return fold(sp.sympify(expr), children, combine, memo)

@@ -13,6 +13,23 @@ from ..errors import ModelError
 
 #: Operations sympy keeps unevaluated that compiled code cannot express.
 _UNEVALUATED = (sp.Sum, sp.Product, sp.Integral, sp.Derivative, sp.Limit)
+_BAD = frozenset((sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I))
+
+
+def _distinct_nodes(e: sp.Basic) -> list[sp.Basic]:
+    """Every distinct subexpression of ``e``, each once: a rigid-body tree's positions share
+    their parents' at every level, and sympy's ``atoms`` and ``has`` walk a shared part again at
+    every use (exponential in the depth of the tree)."""
+    seen: set[int] = set()
+    out, stack = [], [e]
+    while stack:
+        x = stack.pop()
+        if id(x) in seen:
+            continue
+        seen.add(id(x))
+        out.append(x)
+        stack.extend(x.args)
+    return out
 
 
 def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
@@ -26,12 +43,13 @@ def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
         raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
     if not isinstance(e, sp.Expr):
         raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
-    undefined = sorted(str(f.func) for f in e.atoms(AppliedUndef))
+    nodes = _distinct_nodes(e)
+    undefined = sorted({str(f.func) for f in nodes if isinstance(f, AppliedUndef)})
     if undefined:
         raise ModelError(f"model {model!r}: {what} uses undefined function(s) {', '.join(undefined)}")
-    if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
+    if any(x in _BAD for x in nodes if x.is_Atom):
         raise ModelError(f"model {model!r}: {what} contains an infinite, undefined or complex value: {e}")
-    pending = sorted({type(a).__name__ for a in e.atoms(*_UNEVALUATED)})
+    pending = sorted({type(a).__name__ for a in nodes if isinstance(a, _UNEVALUATED)})
     if pending:  # C has no Sum(): it reached the compiler as an undeclared function
         raise ModelError(f"model {model!r}: {what} holds an unevaluated {', '.join(pending)}; write it out "
                          f"(e.g. with .doit()): {e}")

@@ -27,6 +27,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .actuators import Actuators
+from .constrained_tree import ConstrainedTree
 from .dag import dag_diff, free_symbols
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
@@ -66,7 +67,7 @@ class Model(Actuators):
         self._force_vectors: list[tuple[str, sp.Matrix]] = []
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
-        self.tree: RigidTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
+        self.tree: RigidTree | ConstrainedTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
 
     def dt(self, expr: Any) -> Any:
         """Total time derivative of an expression (or vector) of q and t, by the chain rule
@@ -87,13 +88,20 @@ class Model(Actuators):
 
     def diff(self, expr: Any, symbol: sp.Symbol) -> sp.Expr:
         """``∂expr/∂symbol`` (a tree model's shared subexpressions visited once: ``dag_diff``)."""
-        return sp.diff(expr, symbol) if self.tree is None else dag_diff(expr, symbol)
+        return sp.diff(expr, symbol) if self.tree is None else dag_diff(expr, symbol, self._dag_memo(symbol))
 
     def jacobian(self, expr: Any) -> sp.Matrix:
         """``∂expr/∂q`` of a vector expression (e.g. a point's position), one column per coordinate."""
         v = sp.Matrix(expr)
         return v.jacobian(self.q) if self.tree is None else sp.Matrix(
-            v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j]))
+            v.rows, len(self.q), lambda i, j: dag_diff(v[i], self.q[j], self._dag_memo(self.q[j])))
+
+    def _dag_memo(self, symbol: sp.Symbol) -> dict:
+        # one memo per symbol for the model's life: the points of a tree share their parents'
+        # kinematics, so each shared part is differentiated once for all of them (and the
+        # derivatives share as the positions do)
+        memos = self.__dict__.setdefault("_dag_memos", {})
+        return memos.setdefault(symbol, {})
 
     def point_jacobian(self, name: str) -> sp.Matrix:
         """``∂p/∂q`` of a named point (dims × n): its velocity is ``J q̇`` (for control laws)."""
@@ -155,14 +163,16 @@ class Model(Actuators):
     @classmethod
     def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,
                   name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
-                  base_joint: Any = None, base_coordinate: str = "base") -> Model:
+                  base_joint: Any = None, base_coordinate: str = "base", parameters: Any = False) -> Model:
         """The robot of a URDF file with the link ``base`` fixed to the world (or attached by
-        ``base_joint``), and ``contact_points`` — see :mod:`amble.modelling.urdf`."""
+        ``base_joint``), ``contact_points``, and with ``parameters`` (``True`` or kinds among
+        ``mass``, ``com``, ``inertia``, ``length``) its numbers as named run-time parameters — see
+        :mod:`amble.modelling.urdf`."""
         from .urdf import build_model
 
         return build_model(cls, path, base=base, contact_points=contact_points, name=name,
                            allow_massless=allow_massless, gravity=gravity, base_joint=base_joint,
-                           base_coordinate=base_coordinate)
+                           base_coordinate=base_coordinate, parameters=parameters)
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
@@ -299,9 +309,9 @@ class Model(Actuators):
 
         Positions, energies and masses are substituted; generalized forces are mapped by virtual
         work, ``Γ_new = (∂q/∂q_new)ᵀ Γ``, so a torque declared once acts correctly in both modes.
+        A rigid-body tree stays one (:mod:`amble.modelling.constrained_tree`): its equations are
+        the source tree's, projected.
         """
-        if self.tree is not None:  # declare the locked joint fixed in a second model instead
-            raise ModelError(f"model {self.name!r}: constrained() of a rigid-body tree is not supported")
         subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
         for k in subs:
             if k not in self.q:
@@ -318,18 +328,23 @@ class Model(Actuators):
                 raise ModelError(f"model {self.name!r}: {qi} = {v} uses {', '.join(map(str, bad))}")
         vsubs = dict(subs)
         vsubs.update({self.dot(qi): out.dt(v) for qi, v in subs.items()})
-        out.points = {n: p.subs(subs) for n, p in self.points.items()}
+        if self.tree is not None:  # shared expression graphs: each shared part substituted once
+            out.tree = ConstrainedTree(self.tree, out, vsubs)
+            put = out.tree.replace
+        else:
+            put = lambda e: e.subs(vsubs)  # noqa: E731
+        out.points = {n: put(p) for n, p in self.points.items()}
         out.masses = dict(self.masses)
         out.links = list(self.links)
-        out._k_terms = [e.subs(vsubs) for e in self._k_terms]
-        out._k_added = [e.subs(vsubs) for e in self._k_added]
-        out._v_terms = [e.subs(subs) for e in self._v_terms]
+        out._k_terms = [put(e) for e in self._k_terms]
+        out._k_added = [put(e) for e in self._k_added]
+        out._v_terms = [put(e) for e in self._v_terms]
         for attr in ("_k_override", "_v_override", "_l_override"):
             e = getattr(self, attr)
-            setattr(out, attr, None if e is None else e.subs(vsubs))
+            setattr(out, attr, None if e is None else put(e))
         full = sp.Matrix([subs.get(qi, qi) for qi in self.q])
         jac = full.jacobian(out.q)
-        out._forces = [jac.T * f.subs(vsubs) for f in self._forces]
+        out._forces = [jac.T * put(f) for f in self._forces]
         out._g, out._g_dir = self._g, self._g_dir
         if any(e.free_symbols & set(self.derived_placeholders) for e in self._laws.values()):
             raise ModelError(f"model {self.name!r}: a control law written with dynamics() cannot be carried "

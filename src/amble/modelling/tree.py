@@ -31,73 +31,16 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
-from .dag import fold
+from .defs import Defs
 
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
-
-
-class Defs:
-    """Intermediate quantities of a recursion: each non-trivial expression is named by a fresh
-    symbol, so every step works on small expressions (sympy's cost grows with their size).
-
-    :meth:`expand` turns an expression of these symbols back into one of q, q̇ and parameters,
-    as a DAG: each definition is rebuilt once, unevaluated (no flattening, no distribution of
-    numeric factors), and shared by every use — common subexpressions for code generation.
-    """
-
-    def __init__(self) -> None:
-        self._defs: dict[sp.Symbol, sp.Expr] = {}
-        self._done: dict[sp.Basic, sp.Basic] = {}
-
-    def __call__(self, e: Any) -> sp.Expr:
-        e = sp.sympify(e)
-        if e.is_Atom or isinstance(e, sp.Function) or (
-                e.is_Mul and len(e.args) == 2 and e.args[0].is_Number and e.args[1].is_Atom):
-            return e
-        s = sp.Dummy(f"k{len(self._defs)}")
-        self._defs[s] = e
-        return s
-
-    def vec(self, m: sp.Matrix) -> sp.Matrix:
-        return m.applyfunc(self)
-
-    def needed(self, exprs: Any) -> list[tuple[sp.Symbol, sp.Expr]]:
-        """The definitions that ``exprs`` use, directly or not, in an order where each comes
-        after those it uses."""
-        used: set[sp.Symbol] = set()
-        stack = [e for e in exprs]
-        seen: set[sp.Basic] = set()
-        while stack:
-            x = sp.sympify(stack.pop())
-            if x in seen:
-                continue
-            seen.add(x)
-            if isinstance(x, sp.Dummy) and x in self._defs:
-                used.add(x)
-                stack.append(self._defs[x])
-            elif not x.is_Atom:
-                stack.extend(x.args)
-        return [(s, e) for s, e in self._defs.items() if s in used]
-
-    def expand(self, e: Any) -> Any:
-        """``e`` (an expression or matrix of the defined symbols) in q, q̇ and parameters."""
-        if isinstance(e, sp.MatrixBase):
-            return e.applyfunc(self.expand)
-        defs = self._defs
-
-        def children(x: sp.Basic) -> Sequence[sp.Basic]:
-            if isinstance(x, sp.Dummy) and x in defs:
-                return (defs[x],)  # a defined symbol stands for its definition
-            return () if x.is_Atom else x.args
-
-        def combine(x: sp.Basic, args: list[Any]) -> Any:
-            if isinstance(x, sp.Dummy) and x in defs:
-                return args[0]
-            if x.is_Atom:
-                return x
-            return x.func(*args, evaluate=False) if isinstance(x, (sp.Add, sp.Mul)) else x.func(*args)
-
-        return fold(sp.sympify(e), children, combine, self._done)
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "spherical", "floating")
+#: the one-axis joints a spherical or floating joint stands for (suffix of the coordinate, type, axis):
+#: translations along the joint frame's x, y, z, then the rotation ``Rz(yaw) Ry(pitch) Rx(roll)``
+_COMPOSITE = {
+    "spherical": (("yaw", "revolute", (0, 0, 1)), ("pitch", "revolute", (0, 1, 0)), ("roll", "revolute", (1, 0, 0))),
+    "floating": (("x", "prismatic", (1, 0, 0)), ("y", "prismatic", (0, 1, 0)), ("z", "prismatic", (0, 0, 1)),
+                 ("yaw", "revolute", (0, 0, 1)), ("pitch", "revolute", (0, 1, 0)), ("roll", "revolute", (1, 0, 0))),
+}
 
 
 def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
@@ -221,6 +164,12 @@ class RigidTree:
         A moving joint declares the model coordinate ``coordinate`` (default: the body's name),
         in rad for a revolute joint and m for a prismatic one. The centre of mass becomes the
         model point ``name`` carrying ``mass``.
+
+        A ``spherical`` joint (3 coordinates ``<coordinate>_yaw``, ``_pitch``, ``_roll``: the
+        rotation ``Rz(yaw) Ry(pitch) Rx(roll)`` of the joint frame) and a ``floating`` one (6:
+        ``<coordinate>_x``, ``_y``, ``_z`` along the joint frame's axes, then yaw, pitch, roll)
+        are chains of one-axis joints through massless frames — Euler angles, singular at
+        pitch = ±π/2 (gimbal lock), which a walker's base does not reach.
         """
         joint = joint or Joint()
         m = self.model
@@ -229,6 +178,26 @@ class RigidTree:
         if joint.type not in JOINT_TYPES:
             raise ModelError(f"model {m.name!r}: joint of body {name!r} has unknown type {joint.type!r} "
                              f"(known: {', '.join(JOINT_TYPES)})")
+        if joint.type in _COMPOSITE:
+            if joint.post_xyz is not None or joint.post_rotation is not None:
+                raise ModelError(f"model {m.name!r}: a {joint.type} joint (body {name!r}) cannot be reversed")
+            cname = coordinate or name
+            *inner, last = _COMPOSITE[joint.type]
+            for k, (suffix, kind, axis) in enumerate(inner):
+                first = dict(xyz=joint.xyz, rpy=joint.rpy, rotation=joint.rotation) if k == 0 else {}
+                self._add(f"{name}.{suffix}", parent, Joint(kind, axis=axis, **first), 0, (0, 0, 0),
+                          ((0, 0, 0),) * 3, f"{cname}_{suffix}", None, internal=True)
+                parent = f"{name}.{suffix}"
+            suffix, kind, axis = last
+            joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper)
+            coordinate = f"{cname}_{suffix}"
+        return self._add(name, parent, joint, mass, com, inertia, coordinate, unit)
+
+    def _add(self, name: str, parent: str | None, joint: Joint, mass: Any, com: Sequence[Any], inertia: Any,
+             coordinate: str | None, unit: str | None, internal: bool = False) -> Body:
+        """A body of a one-axis (or fixed) joint; ``internal``: a massless frame of a composite
+        joint, which is not a model point."""
+        m = self.model
         par = None
         if parent is not None:
             if parent not in self._by_name:
@@ -252,13 +221,17 @@ class RigidTree:
         self._kinematics(b)
         self.bodies.append(b)
         self._by_name[name] = b
+        if internal:
+            return b
         r = self.defs.vec(_matmul(b.R, b.com))
         m.point(name, self.defs.expand(b.p + r))
         self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
         self.com_points[name] = b
         if mass_e != 0:
             m.mass(name, mass_e)
-        if par is not None and par.name in m.points:
+        while par is not None and par.name not in m.points:  # past a composite joint's frames
+            par = par.parent
+        if par is not None:
             m.link(par.name, name)
         return b
 
@@ -280,30 +253,106 @@ class RigidTree:
         return [b for b in self.bodies if b.moving]
 
     def kinetic(self) -> sp.Expr:
-        """Kinetic energy of the bodies from their velocities: Σ ½ (m |v_c|² + ωᵀ R I Rᵀ ω)."""
+        """Kinetic energy of the bodies from their body-frame velocities ``(ω, v)`` (``v`` of the
+        body's origin): Σ ½ (ωᵀ I_o ω + m |v|² + 2 m c·(v × ω)), ``I_o`` about the origin."""
         key = ("K", len(self.bodies))
         if key in self._energies:
             return self._energies[key]
         d = self.defs
         out = []
+        vel = self.body_velocities()
         for b in self.bodies:
-            vc = d.vec(b.vel + b.omega.cross(d.vec(_matmul(b.R, b.com))))
-            wb = d.vec(_matmul(b.R.T, b.omega))
-            iw = d.vec(_matmul(b.inertia, wb))
-            out.append(d(b.mass * d((vc.T * vc)[0, 0]) + d((wb.T * iw)[0, 0])))
+            m, h, I = self.body_inertia(b)
+            w, v = vel[b.name][:2]
+            e = _dot(w, d.vec(_matmul(I, w))) + m * _dot(v, v) + 2 * _dot(h, d.vec(_cross(v, w)))
+            if e != 0:
+                out.append(d(e))
         self._energies[key] = d.expand(sp.Add(*out) / 2)
         return self._energies[key]
 
+    def body_inertia(self, b: Body) -> tuple[sp.Expr, sp.Matrix, sp.Matrix]:
+        """Mass, first moment ``m c`` and rotational inertia ``I_c + m (|c|² 1 − c cᵀ)`` of ``b``
+        about its frame's origin, in its axes (constants of the model)."""
+        d, c, m = self.defs, b.com, b.mass
+        cc = _dot(c, c)
+        I = sp.Matrix(3, 3, lambda i, j: b.inertia[i, j] + m * ((cc if i == j else 0) - c[i] * c[j]))
+        return m, d.vec(c * m), d.vec(I)
+
+    def body_velocities(self) -> dict[str, tuple[sp.Matrix, ...]]:
+        """Spatial velocity of every body in its own frame, by recursion from the base:
+        ``(ω, v, ω_j, v_j)`` — angular velocity, velocity of the origin, and the joint's share
+        ``Sᵢ q̇ᵢ`` of both (zero for a fixed joint). Named intermediates of :attr:`defs`, which
+        the dynamics (:mod:`amble.derivation.tree`) reuse."""
+        key = ("vel", len(self.bodies))
+        if key in self._energies:
+            return self._energies[key]
+        d, out, zero = self.defs, {}, sp.zeros(3, 1)
+        for b in self.bodies:
+            E, r = (d.vec(x) for x in self.local_transform(b))
+            if b.parent is None:
+                w, v = zero, zero
+            else:
+                wp, vp = out[b.parent.name][:2]
+                w, v = d.vec(_matmul(E.T, wp)), d.vec(_matmul(E.T, vp + _cross(wp, r)))
+            sw = sv = zero
+            if b.moving:
+                qd = self.model.dot(b.coordinate)
+                a, o = self.local_subspace(b)
+                sw, sv = d.vec(a * qd), d.vec(o * qd)
+                w, v = d.vec(w + sw), d.vec(v + sv)
+            out[b.name] = (w, v, sw, sv)
+        self._energies[key] = out
+        return out
+
     def potential(self, gravity: sp.Matrix) -> sp.Expr:
-        """Gravitational potential energy of the bodies: Σ −m g·c."""
+        """Gravitational potential energy of the bodies, Σ −m g·c, by recursion in body frames:
+        with ``gᵢ = Eᵢᵀ g_parent`` (gravity in body i's axes) and ``zᵢ = z_parent + g_parent·rᵢ``
+        (g · the origin of body i), ``−m g·c = −m zᵢ − gᵢ·(m c)`` — three rotated components per
+        body instead of every body's world rotation."""
         key = ("V", len(self.bodies), tuple(gravity))
         if key in self._energies:
             return self._energies[key]
-        d = self.defs
-        out = [d(-b.mass * d(sp.Add(*[g * c for g, c in zip(gravity, d.vec(b.p + _matmul(b.R, b.com))) if g != 0])))
-               for b in self.bodies]
+        d, out = self.defs, []
+        gz: dict[str, tuple[sp.Matrix, sp.Expr]] = {}
+        for b in self.bodies:
+            E, r = (d.vec(x) for x in self.local_transform(b))
+            gp, zp = gz[b.parent.name] if b.parent is not None else (gravity, sp.Integer(0))
+            gz[b.name] = g, z = d.vec(_matmul(E.T, gp)), d(zp + _dot(gp, r))
+            m, h, _ = self.body_inertia(b)
+            e = -m * z - _dot(g, h)
+            if e != 0:
+                out.append(d(e))
         self._energies[key] = d.expand(sp.Add(*out))
         return self._energies[key]
+
+    # ------------------------------------------------------------------ joint transforms
+    def local_transform(self, b: Body) -> tuple[sp.Matrix, sp.Matrix]:
+        """``(E, r)``: body ``b``'s frame in its parent's (or the world's), ``x_parent = E x_b + r``
+        — the joint origin, the joint motion by ``qᵢ``, then any fixed offset after the motion."""
+        j = b.joint
+        Ro = _mat3(j.rotation) if j.rotation is not None else _mat3(rpy_matrix(j.rpy))
+        E, r = Ro, _vec(j.xyz)
+        if j.type == "prismatic":
+            r = r + _matmul(Ro, _vec(j.axis) * b.coordinate)
+        elif j.type != "fixed":
+            E = _matmul(Ro, _rotation(_vec(j.axis), sp.cos(b.coordinate), sp.sin(b.coordinate)))
+        if j.post_xyz is not None:
+            r = r + _matmul(E, _vec(j.post_xyz))
+        if j.post_rotation is not None:
+            E = _matmul(E, _mat3(j.post_rotation))
+        return E, r
+
+    def local_subspace(self, b: Body) -> tuple[sp.Matrix, sp.Matrix]:
+        """The motion subspace of ``b``'s joint in ``b``'s own frame, ``(angular, linear at the
+        origin)`` per unit of q̇ᵢ — constant: ``(a, o × a)`` for a revolute joint about the axis
+        ``a`` through the point ``o``, ``(0, a)`` for a prismatic one."""
+        j = b.joint
+        Pt = _mat3(j.post_rotation).T if j.post_rotation is not None else sp.eye(3)
+        a = _matmul(Pt, _vec(j.axis))
+        if j.type == "prismatic":
+            return sp.zeros(3, 1), a
+        o = -_matmul(Pt, _vec(j.post_xyz or (0, 0, 0)))   # the joint's origin, seen from the body
+        return a, o.cross(a)
 
     # ------------------------------------------------------------------ kinematics
     def _kinematics(self, b: Body) -> None:
@@ -347,6 +396,19 @@ def _matmul(A: sp.Matrix, B: sp.Matrix) -> sp.Matrix:
         for k in range(B.cols):
             out[i, k] = sp.Add(*[A[i, j] * B[j, k] for j in range(A.cols) if A[i, j] != 0 and B[j, k] != 0])
     return out
+
+
+def _dot(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
+    """Dot product that skips zero terms."""
+    return sp.Add(*[x * y for x, y in zip(a, b) if x != 0 and y != 0])
+
+
+def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
+    """Cross product that skips zero terms."""
+    def term(i: int, j: int) -> sp.Expr:
+        return a[i] * b[j] if a[i] != 0 and b[j] != 0 else sp.Integer(0)
+
+    return sp.Matrix([term(1, 2) - term(2, 1), term(2, 0) - term(0, 2), term(0, 1) - term(1, 0)])
 
 
 def _mul_add(A: sp.Matrix, x: sp.Matrix, y: sp.Matrix) -> sp.Matrix:

@@ -17,12 +17,23 @@ The user chooses the base link, fixed to the world (e.g. the stance foot): the t
 there, joints between the base and the URDF root are traversed backwards (the same joint
 coordinate, motion inverted). Joint coordinates are named as the joints, the centre of mass of
 each link is a model point named as the link, and ``contact_points`` name further points:
-``{"heel": ("left_foot", (0.0, 0.0, -0.05))}``. Masses and inertias are constants of the model.
+``{"heel": ("left_foot", (0.0, 0.0, -0.05))}``.
+
+Masses, centres of mass, inertias and joint offsets are constants of the compiled model unless
+``parameters`` asks for them as named model parameters (run-time inputs: a sweep over a link
+mass recompiles nothing), with the file's values as defaults — ``True`` for all, or some of
+``"mass"`` (``m_<link>``, kg, positive), ``"com"`` (``cx_<link>``, ``cy_…``, ``cz_…``, m, in
+the link frame), ``"inertia"`` (``Ixx_<link>``, ``Ixy_…``, ``Ixz_…``, ``Iyy_…``, ``Iyz_…``,
+``Izz_…``, kg m², about the centre of mass in the link frame) and ``"length"`` (``x_<joint>``,
+``y_…``, ``z_…``, m: the joint origin in its parent link's frame). An entry that is zero in the
+file stays an exact zero (it shapes the compiled code: making it nonzero is a new structure),
+and characters other than letters, digits and ``_`` in a name become ``_``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import re
+from collections.abc import Collection, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +43,43 @@ from ..errors import ModelError
 from .tree import Joint
 
 _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+PARAMETER_KINDS = ("mass", "com", "inertia", "length")
+
+
+class _Params:
+    """The file's numbers, as named model parameters for the chosen kinds (zeros stay zeros)."""
+
+    def __init__(self, model: Any, parameters: bool | Collection[str]) -> None:
+        kinds = set(PARAMETER_KINDS) if parameters is True else set(parameters or ())
+        bad = kinds - set(PARAMETER_KINDS)
+        if bad:
+            raise ModelError(f"from_urdf: unknown parameter kind(s) {', '.join(sorted(bad))} "
+                             f"(known: {', '.join(PARAMETER_KINDS)})")
+        self.model, self.kinds = model, kinds
+
+    def _one(self, kind: str, name: str, value: float, unit: str, doc: str) -> Any:
+        if kind not in self.kinds or value == 0.0:
+            return float(value)
+        from .domain import POSITIVE
+
+        name = re.sub(r"\W", "_", name)
+        return self.model.parameter(name, float(value), doc=doc, unit=unit,
+                                    domain=POSITIVE if kind == "mass" else None)
+
+    def inertial(self, link: str, mass: float, com: np.ndarray, inertia: np.ndarray) -> tuple[Any, Any, Any]:
+        m = self._one("mass", f"m_{link}", mass, "kg", f"mass of link {link}")
+        c = tuple(self._one("com", f"c{a}_{link}", v, "m", f"centre of mass of link {link}, {a}")
+                  for a, v in zip("xyz", com))
+        ax = "xyz"
+        entries = {(i, j): self._one("inertia", f"I{ax[i]}{ax[j]}_{link}", inertia[i, j], "kg*m^2",
+                                     f"inertia of link {link} about its centre of mass, {ax[i]}{ax[j]}")
+                   for i in range(3) for j in range(i, 3)}
+        I = [[entries[min(i, j), max(i, j)] for j in range(3)] for i in range(3)]
+        return m, c, I
+
+    def offset(self, joint: str, xyz: np.ndarray) -> tuple[Any, ...]:
+        return tuple(self._one("length", f"{a}_{joint}", v, "m", f"origin of joint {joint}, {a}")
+                     for a, v in zip("xyz", xyz))
 
 
 def _read(path: Path) -> Any:
@@ -66,10 +114,12 @@ def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
 
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
                 name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
-                base_joint: Joint | None = None, base_coordinate: str = "base") -> Any:
+                base_joint: Joint | None = None, base_coordinate: str = "base",
+                parameters: bool | Collection[str] = False) -> Any:
     """A model (of class ``cls``, a :class:`~amble.modelling.model.Model`) of the URDF at ``path``
     with ``base`` fixed to the world (default: the URDF's root link), or attached to it by
-    ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``."""
+    ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``;
+    ``parameters``: which numbers become named model parameters (module docstring)."""
     path = Path(path)
     robot = _read(path).robot
     links = {lk.name: lk for lk in robot.links}
@@ -122,13 +172,15 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             _check_inertial(lk)
     model = cls(name or robot.name or path.stem, dims=3)
     model.gravity(gravity)
+    par = _Params(model, parameters)
     tree = model.rigid_tree()
     top = None
     if base_joint is not None:
         link = links[base]
         mass, com, inertia = (_check_inertial(link) if link.inertial is not None
                               else (0.0, np.zeros(3), np.zeros((3, 3))))
-        tree.body(base, joint=base_joint, mass=mass, com=tuple(com), inertia=inertia, coordinate=base_coordinate)
+        mass, com, inertia = par.inertial(base, mass, com, inertia)
+        tree.body(base, joint=base_joint, mass=mass, com=com, inertia=inertia, coordinate=base_coordinate)
         top = base
     for lk, parent, j, forward in order:
         parent = parent or top
@@ -140,19 +192,23 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             mass, com, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
         else:
             mass, com, inertia = _check_inertial(link)
+        mass, com, inertia = par.inertial(lk, mass, com, inertia)
         T = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+        xyz = np.asarray(par.offset(j.name, T[:3, 3]), dtype=object)
         axis = np.asarray(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
         lower = upper = None
         if j.type in ("revolute", "prismatic") and j.limit is not None:
             lower, upper = j.limit.lower, j.limit.upper
         if forward:
-            joint = Joint(j.type, axis=tuple(axis), xyz=tuple(T[:3, 3]), rotation=T[:3, :3],
+            joint = Joint(j.type, axis=tuple(axis), xyz=tuple(xyz), rotation=T[:3, :3],
                           lower=lower, upper=upper)
         else:  # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
             Rt = T[:3, :3].T
-            joint = Joint(j.type, axis=tuple(-axis), post_xyz=tuple(-Rt @ T[:3, 3]), post_rotation=Rt,
+            post = [-sum((Rt[i, k] * xyz[k] for k in range(3) if Rt[i, k] != 0 and xyz[k] != 0), 0.0)
+                    for i in range(3)]
+            joint = Joint(j.type, axis=tuple(-axis), post_xyz=tuple(post), post_rotation=Rt,
                           lower=lower, upper=upper)
-        tree.body(lk, parent=parent, joint=joint, mass=mass, com=tuple(com), inertia=inertia,
+        tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
     for pname, spec in (contact_points or {}).items():
         try:
