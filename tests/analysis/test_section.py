@@ -71,7 +71,9 @@ def test_humanoid_3d_basin_cell_at_the_fixed_point_converges():
     res = basin(s, ("stance", "stance_dot"), ((xs[a] - 0.01, xs[a] + 0.01), (xs[b] - 0.05, xs[b] + 0.05)), (3, 3),
                 steps=30, **SYNC)
     assert res.outcome[1, 1] == 0  # converged, at the fixed point itself
-    assert res.counts()["failed"] == 0
+    # every cell was put on the section and walked; a walk may end in a terminal outcome of the
+    # model (the knee-swing foot scuffing the ground), never for want of a section state
+    assert not {"off the section", "invalid initial state"} & set(res.reasons.ravel())
 
 
 @pytest.mark.slow

@@ -36,7 +36,7 @@ def _closed_form(t: float, x0: float, v0: float, k: float = 1e4, c: float = 1e4)
 
 def test_radau_matches_the_closed_form_in_few_steps():
     s = _overdamped()
-    k = build(s)
+    k = build(s, derivatives=True)
     p = parameter_vector(k, None, s)
     x0 = np.array([1.0, 0.0])
     steps = {}
@@ -79,7 +79,7 @@ def test_a_stiff_explicit_run_suggests_the_implicit_integrator():
 
 def test_sensitivities_need_the_explicit_integrator():
     s = load("compass-gait")
-    k = build(s)
+    k = build(s, derivatives=True)
     with pytest.raises(StateError, match="sensitivities need method='dop853'"):
         run(k, parameter_vector(k, None, s), 0, np.asarray(s.fixed_point_guess, float), steps=1,
             opts=Options(method="radau"), sensitivities=True)

@@ -93,7 +93,7 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
 
     ``to_state`` ``None``: cells are put on the section (``section``: transition, time, pre-impact
     state and the section coordinates; built here, in the worker, from the compiled kernels)."""
-    k = build(system)
+    k = build(system, derivatives=section is not None)
     mi = 0
     n = k.meta["nx"][mi]
     p = np.asarray(pvec, float)

@@ -116,7 +116,7 @@ class ReturnMap:
             raise ModelError(f"system {system.name!r} has no step transition: a return map (fixed point, "
                              f"period-k orbit) needs a transition declared with step=True")
         self.system = system
-        self.k: Kernels = build(system)
+        self.k: Kernels = build(system, derivatives=True)  # exact Jacobians, the section's chart
         self.p = parameter_vector(self.k, params, system)
         self.period = period
         self.mode = mode or self.k.meta["modes"][0]

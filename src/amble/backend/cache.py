@@ -241,14 +241,20 @@ def _key(structure: str, env_cc: str, env_flags: str, env_path: str) -> str:
     return h.hexdigest()[:24]
 
 
-def library(system: HybridSystem, key: str) -> tuple[Path, dict]:
+def derivatives_key(key: str) -> str:
+    """Cache key of the library that also holds the derivative kernels (a superset of ``key``'s)."""
+    return hashlib.sha256(f"{key}:derivatives".encode()).hexdigest()[:24]
+
+
+def library(system: HybridSystem, key: str, derivatives: bool = False) -> tuple[Path, dict]:
     """Path of the system's compiled library and its loader metadata: the cached ones if they are
-    intact (:func:`cached`), else built now."""
+    intact (:func:`cached`), else built now. ``key`` is the library's own key (for ``derivatives``,
+    :func:`derivatives_key`)."""
     d = cache_dir()
     hit = cached(d, key)
     if hit is not None:
         return hit
-    return rebuild(system, key, d)
+    return rebuild(system, key, d, derivatives)
 
 
 def cached(d: Path, key: str) -> tuple[Path, dict] | None:
@@ -263,13 +269,13 @@ def cached(d: Path, key: str) -> tuple[Path, dict] | None:
     return (so, meta) if ok else None
 
 
-def rebuild(system: HybridSystem, key: str, d: Path | None = None) -> tuple[Path, dict]:
+def rebuild(system: HybridSystem, key: str, d: Path | None = None, derivatives: bool = False) -> tuple[Path, dict]:
     """Generate, compile and record the library of ``system`` under ``key`` (replacing any entry)."""
     from .codegen import generate
 
     d = d or cache_dir()
     _remove_orphans(d)
-    src, meta = generate(system)
+    src, meta = generate(system, derivatives=derivatives)
     so, digest = _compile(src, key, d)
     meta = {**meta, "library": so.name, "library_sha256": digest}
     _write_atomic(d / f"{key}.json", json.dumps(meta).encode())

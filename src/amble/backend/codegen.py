@@ -27,11 +27,13 @@ from .codegen_support import Printer as _Printer
 from .codegen_support import block as _block
 from .codegen_support import bool_expr as _bool_block
 from .codegen_support import symbol_names as _names
-from .variational_codegen import reset_jacobian_code, rhs_jacobian_code, surfaces_gradient_code
+from .variational_codegen import derivative_kernels, derivative_stubs
 
 
-def generate(system: HybridSystem) -> tuple[str, dict]:
-    """Generate the C source of a system; returns (source, metadata for the loader)."""
+def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict]:
+    """Generate the C source of a system; returns (source, metadata for the loader). With
+    ``derivatives`` also the derivative kernels of sensitivity runs and of the implicit
+    integrator (several times longer than the rest: built only when asked for)."""
     params = list(system.parameters)
     modes = {name: ModeInfo(m, derive(m), i) for i, (name, m) in enumerate(system.modes.items())}
     points = system.point_names
@@ -161,19 +163,11 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         w(f"    (void)t; (void)x; (void)p;\n    return ({cond}) ? 1 : 0;\n}}\n")
         w(_reset_code(i, tr, src, modes, nm, params))
 
-    # derivatives for sensitivity runs: flow Jacobians, surface gradients, reset Jacobians. Their
-    # straight-line code is an order of magnitude longer than the right-hand side's, and GCC's
-    # optimiser is superlinear in the length of a basic block (humanoid-3d: 8 s → 63 s at -O2);
-    # unoptimised they compile in seconds and cost a sensitivity run about 2× more
-    w("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC push_options\n#pragma GCC optimize (\"O0\")\n#endif\n")
-    for name, mi in modes.items():
-        nm = _names(mi.model, params)
-        surf = [sp.sympify(tr.guard.expr) for tr in trs_by_mode[name]] + list(switches[name])
-        w(rhs_jacobian_code(mi, nm, params))
-        w(surfaces_gradient_code(mi, surf, nm, params))
-    for i, tr in enumerate(order):
-        w(reset_jacobian_code(i, tr, modes[tr.source], modes, _names(modes[tr.source].model, params), params))
-    w("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC pop_options\n#endif\n")
+    # derivatives for sensitivity runs and the implicit integrator, or stubs (variational_codegen)
+    if derivatives:
+        w(derivative_kernels(modes, order, trs_by_mode, switches, params))
+    else:
+        w(derivative_stubs())
 
     # dispatchers
     def dispatch(sig: str, ret: str, call: str, names: list[str], key: str) -> None:
@@ -204,14 +198,6 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
              "energy_{}(t, x, p, out)", mode_list, "mode")
     dispatch("kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel)",
              "void", "kinematics_{}(t, x, p, pos, vel)", mode_list, "mode")
-    dispatch("rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J)", "int",
-             "rhs_jac_{}(t, x, p, dx, J)", mode_list, "mode")
-    dispatch("rhs_jacp(int mode, double t, const double *x, const double *p, double *J)", "int",
-             "rhs_jacp_{}(t, x, p, J)", mode_list, "mode")
-    dispatch("surfaces_grad(int mode, double t, const double *x, const double *p, double *G)", "void",
-             "surfaces_grad_{}(t, x, p, G)", mode_list, "mode")
-    dispatch("reset_jac(int tr, double t, const double *x, const double *p, double *D)", "int",
-             "reset_jac_{}(t, x, p, D)", [tr.name for tr in order], "tr")
     dispatch("enabled(int tr, double t, const double *x, const double *p)", "int",
              "enabled_{}(t, x, p)", [tr.name for tr in order], "tr")
     dispatch("reset(int tr, double t, const double *x, const double *p, double *xout, int *target)", "int",
@@ -239,6 +225,7 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
         ],
         "dims": system.dims,
         "switches": [{"mode": mn, "expr": str(e)} for mn in mode_list for e in switches[mn]],
+        "derivatives": derivatives,
     }
     return "".join(out), meta
 

@@ -30,16 +30,25 @@ _iptr = ctypes.POINTER(ctypes.c_int)
 _i64ptr = ctypes.POINTER(ctypes.c_int64)
 
 
-def build(system: HybridSystem) -> Kernels:
-    """Compiled kernels of a system, from the in-process cache, the disk cache, or a fresh build."""
-    key = cache.structure_key(system)
-    k = _LOADED.get(key)
+def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
+    """Compiled kernels of a system, from the in-process cache, the disk cache, or a fresh build.
+
+    ``derivatives``: also the derivative kernels (flow and reset Jacobians, guard gradients) that
+    sensitivity runs, exact return-map Jacobians and the implicit integrator need. They are
+    several times longer than the rest, so a library is built with them only when asked; one that
+    has them serves plain runs too, and is preferred when it is at hand."""
+    plain = cache.structure_key(system)
+    full = cache.derivatives_key(plain)
+    k = _LOADED.get(full) or (None if derivatives else _LOADED.get(plain))
+    if k is None and not derivatives and cache.cached(cache.cache_dir(), full) is not None:
+        derivatives = True  # already compiled with them: no second build
     if k is None:
-        so, meta = cache.library(system, key)
+        key = full if derivatives else plain
+        so, meta = cache.library(system, key, derivatives)
         try:
             k = Kernels(so, meta)
         except CompileError:  # intact bytes that do not load (another layout, a foreign build): rebuild once
-            so, meta = cache.rebuild(system, key)
+            so, meta = cache.rebuild(system, key, derivatives=derivatives)
             k = Kernels(so, meta)
         _LOADED[key] = k
     return _with_defaults(k, system)
@@ -151,10 +160,16 @@ class Kernels:
         mode = self.meta["modes"][target.value]
         return mode, out[: self.meta["nx"][target.value]].copy()
 
-    # -- exact derivatives (generated from the symbolic model; see derivation/variational.py)
+    # -- exact derivatives (generated from the symbolic model; see backend/variational_codegen.py)
+    def _need_derivatives(self) -> None:
+        if not self.meta.get("derivatives"):
+            raise ModelError(f"system {self.meta['name']!r}: these kernels were built without their derivatives; "
+                             "use build(system, derivatives=True)")
+
     def rhs_jacobian(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
+        self._need_derivatives()
         mi = self.mode_index(mode)
         nx = self.meta["nx"][mi]
         x = _vec(x, nx)
@@ -170,6 +185,7 @@ class Kernels:
                           ) -> tuple[np.ndarray, np.ndarray]:
         """``(∂g/∂x, ∂g/∂p)`` of a mode's guards (one row per transition from it, in order), then
         its switching surfaces."""
+        self._need_derivatives()
         mi = self.mode_index(mode)
         nx = self.meta["nx"][mi]
         x = _vec(x, nx)
@@ -183,6 +199,7 @@ class Kernels:
     def reset_jacobian(self, transition: int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
+        self._need_derivatives()
         trs = self.meta["transitions"]
         src = self.meta["modes"].index(trs[transition]["source"])
         dst = self.meta["modes"].index(trs[transition]["target"]) if trs[transition]["target"] else src

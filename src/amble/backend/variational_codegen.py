@@ -25,7 +25,7 @@ import sympy as sp
 from ..derivation.impact import impulse_data
 from ..modelling.hybrid import Explicit, target_exprs
 from ..modelling.model import Model, t
-from .codegen_support import ModeInfo
+from .codegen_support import ModeInfo, symbol_names
 from .tangents import jacobian_block
 
 
@@ -184,3 +184,53 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
     code += f"            D[a * (SC + 1) + col[v]] = dqn[a * {nv} + v];\n"
     code += f"            D[({nd} + a) * (SC + 1) + col[v]] = s;\n        }}\n    return 0;\n}}\n"
     return code
+
+
+_SIGNATURES = (
+    ("int", "rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J)",
+     "mode", "rhs_jac_{}(t, x, p, dx, J)"),
+    ("int", "rhs_jacp(int mode, double t, const double *x, const double *p, double *J)", "mode",
+     "rhs_jacp_{}(t, x, p, J)"),
+    ("void", "surfaces_grad(int mode, double t, const double *x, const double *p, double *G)", "mode",
+     "surfaces_grad_{}(t, x, p, G)"),
+    ("int", "reset_jac(int tr, double t, const double *x, const double *p, double *D)", "tr",
+     "reset_jac_{}(t, x, p, D)"),
+)
+
+
+def derivative_kernels(modes: dict[str, ModeInfo], order: list, trs_by_mode: dict[str, list],
+                       switches: dict[str, list[sp.Expr]], params: list[str]) -> str:
+    """All derivative kernels of a system and their dispatchers (``rhs_jac``, ``rhs_jacp``,
+    ``surfaces_grad``, ``reset_jac``)."""
+    # Their straight-line code is an order of magnitude longer than the right-hand side's, and
+    # GCC's optimiser is superlinear in the length of a basic block (humanoid-3d: 8 s → 63 s at
+    # -O2); unoptimised they compile in seconds and cost a sensitivity run about 1.5× more.
+    out = ["#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC push_options\n"
+           "#pragma GCC optimize (\"O0\")\n#endif\n"]
+    for name, mi in modes.items():
+        nm = symbol_names(mi.model, params)
+        surf = [sp.sympify(tr.guard.expr) for tr in trs_by_mode[name]] + list(switches[name])
+        out.append(rhs_jacobian_code(mi, nm, params))
+        out.append(surfaces_gradient_code(mi, surf, nm, params))
+    for i, tr in enumerate(order):
+        out.append(reset_jacobian_code(i, tr, modes[tr.source], modes, symbol_names(modes[tr.source].model, params),
+                                       params))
+    out.append("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC pop_options\n#endif\n")
+    counts = {"mode": len(modes), "tr": len(order)}
+    for ret, sig, key, call in _SIGNATURES:
+        ret_kw, brk = ("return ", "") if ret != "void" else ("", " break;")
+        cases = "".join(f"    case {j}: {ret_kw}{call.format(j)};{brk}\n" for j in range(counts[key]))
+        out.append(f"static {ret} {sig} {{\n    switch ({key}) {{\n{cases}    }}\n"
+                   + ("    return -1;\n" if ret != "void" else "") + "}\n")
+    return "".join(out)
+
+
+def derivative_stubs() -> str:
+    """Stand-ins of the derivative kernels in a library built without them: they report
+    ``AMBLE_ERR_NO_DERIVATIVES`` (the Python side asks for the library with them first)."""
+    out = []
+    for ret, sig, _, _ in _SIGNATURES:
+        args = [a.split()[-1].lstrip("*") for a in sig[sig.index("(") + 1 : -1].split(",")]
+        body = "".join(f"(void){a}; " for a in args)
+        out.append(f"static {ret} {sig} {{ {body}{'return AMBLE_ERR_NO_DERIVATIVES; ' if ret != 'void' else ''}}}\n")
+    return "".join(out)

@@ -182,6 +182,9 @@ def run(
     buf = _Buffers(0 if events_only else 1024, 64, nxm) if record else _NO_RECORDING
     if sensitivities not in (False, True, "state"):
         raise StateError(f"sensitivities must be True, False or 'state', got {sensitivities!r}")
+    if (sensitivities or opts.method != "dop853") and not k.meta.get("derivatives"):
+        raise StateError(f"system {k.meta['name']!r}: sensitivities and the implicit integrator need the kernels "
+                         "built with their derivatives: build(system, derivatives=True)")
     if sensitivities and opts.method != "dop853":
         # the variational equations ride on the explicit method's stages
         raise StateError(f"sensitivities need method='dop853', not {opts.method!r}")

@@ -138,7 +138,8 @@ def simulate(
     for name, v in (("rtol", rtol), ("atol", atol)):
         if not (v > 0 and math.isfinite(v)):
             raise StateError(f"{name} must be a positive number, got {v}")
-    k = build(system)
+    implicit = (method or (options.method if options else "dop853")) == "radau"
+    k = build(system, derivatives=implicit)  # the implicit integrator's Newton matrix is the exact Jacobian
     p = parameter_vector(k, params, system)
     mi, x = initial_state(system, k, x0, mode)
     if steps is None and t_end is None:

@@ -13,6 +13,7 @@
 /* Error codes returned by kernels (0 = ok). */
 #define AMBLE_ERR_SINGULAR_MASS 1
 #define AMBLE_ERR_SINGULAR_RESET 2
+#define AMBLE_ERR_NO_DERIVATIVES 3 /* a library built without its derivative kernels */
 
 /* Solve A x = b for symmetric positive definite A (row-major n x n, only the lower triangle is
  * read; A is overwritten by its Cholesky factor, b by x). Returns AMBLE_ERR_SINGULAR_MASS if a
