@@ -91,7 +91,10 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     tg += [f"G[{i}]" for i in range(n)]
     ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
     ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
-    out = [f"static void mh_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n",
+    # small kernels are inlined into both callers (a call costs as much as their body); large ones
+    # are compiled once, which is the point of emitting them once
+    inline = "AMBLE_INLINE " if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
+    out = [f"static {inline}void mh_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n",
            "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n"]
     out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
             f"    double M[{n * n}], h[{n}], f[{n}];\n",
@@ -106,6 +109,9 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
             "}\n"]
     return "".join(out)
 
+
+#: Largest ``mh_k`` (operations of M, h, Γ) that is forced inline into ``rhs_k`` and ``dynamics_k``.
+INLINE_OPS = 400
 
 #: Largest system whose LDLᵀ solve is written out statement by statement; larger ones call the
 #: loop in ``amble_core.h`` (unrolled code grows as n³/6 and so does its compile time).
@@ -133,8 +139,7 @@ def ldl_solve_code(n: int, a: str, b: str, indent: str = "    ") -> str:
         s = " - ".join([A(j, j)] + [f"{A(j, k)} * u{j}_{k}" for k in range(j)])
         w(f"{ind}const double d{j} = {s};")
         w(f"{ind}if (!(d{j} > 0.0)) return AMBLE_ERR_SINGULAR_MASS;")
-        if j + 1 < n:
-            w(f"{ind}const double r{j} = 1.0 / d{j};")
+        w(f"{ind}const double r{j} = 1.0 / d{j};")  # one division per pivot, none in the solve
         for i in range(j + 1, n):
             s = " - ".join([A(i, j)] + [f"{A(i, k)} * u{j}_{k}" for k in range(j)])
             w(f"{ind}{A(i, j)} = ({s}) * r{j};")
@@ -146,7 +151,7 @@ def ldl_solve_code(n: int, a: str, b: str, indent: str = "    ") -> str:
     for i in range(1, n):  # L y = b
         w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(i, k)} * {b}[{k}]" for k in range(i)) + ";")
     for i in range(n):  # D z = y
-        w(f"{ind}{b}[{i}] /= d{i};")
+        w(f"{ind}{b}[{i}] *= r{i};")
     for i in range(n - 2, -1, -1):  # Lᵀ x = z
         w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(k, i)} * {b}[{k}]" for k in range(i + 1, n)) + ";")
     w(f"{indent}}}")
@@ -182,6 +187,8 @@ def generate(system: HybridSystem) -> tuple[str, dict]:
     w('#include "amble_core.h"\n')
     w(abi.c_header())
     w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
+    if len(set(nx)) == 1:  # one state length: the integrator's loops get constant trip counts
+        w(f"#define NX_FIXED {nx[0]}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
     w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
     w(f"static const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")

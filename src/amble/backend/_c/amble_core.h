@@ -9,6 +9,13 @@
 #include <math.h>
 #include <string.h>
 
+/* Inline a small generated function into every caller (the compiler's own choice otherwise). */
+#if defined(__GNUC__) || defined(__clang__)
+#define AMBLE_INLINE inline __attribute__((always_inline))
+#else
+#define AMBLE_INLINE inline
+#endif
+
 /* Error codes returned by kernels (0 = ok). */
 #define AMBLE_ERR_SINGULAR_MASS 1
 #define AMBLE_ERR_SINGULAR_RESET 2
