@@ -135,47 +135,57 @@ static int dop_step(Dop *s, int mode, const double *p, double t_bound, double rt
     }
 }
 
-/* 7th-order continuous extension of the last step (three extra stages). */
+/* 7th-order continuous extension of the last step (three extra stages). The sums run over the
+ * stages outermost, so each state component is an independent accumulator (no chain of
+ * dependent multiply-adds per component), and skip the tableau's zeros; the order of the
+ * additions per component is that of the plain sum, so the result is bitwise the same. */
 static int dop_dense_prepare(Dop *s, int mode, const double *p) {
     if (s->dense_ready) return 0;
     const int n = DOP_N(s);
     const double h = s->h;
-    double ytmp[NXMAX];
+    double acc[NXMAX];
     for (int st = DOP_STAGES + 1; st < DOP_STAGES_EXT; ++st) {
         const double *a = DOP_A + st * DOP_STAGES_EXT;
-        for (int i = 0; i < n; ++i) {
-            double acc = 0.0;
-            for (int j = 0; j < st; ++j) acc += a[j] * s->K[j][i];
-            ytmp[i] = s->y_old[i] + h * acc;
+        for (int i = 0; i < n; ++i) acc[i] = 0.0;
+        for (int j = 0; j < st; ++j) {
+            const double c = a[j];
+            if (c == 0.0) continue;
+            for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
         }
-        if (rhs(mode, s->t_old + DOP_C[st] * h, ytmp, p, s->K[st])) return ST_SINGULAR_MASS;
+        for (int i = 0; i < n; ++i) acc[i] = s->y_old[i] + h * acc[i];
+        if (rhs(mode, s->t_old + DOP_C[st] * h, acc, p, s->K[st])) return ST_SINGULAR_MASS;
     }
     for (int i = 0; i < n; ++i) {
         double dy = s->y[i] - s->y_old[i];
         s->F[0][i] = dy;
         s->F[1][i] = h * s->f_old[i] - dy;
         s->F[2][i] = 2.0 * dy - h * (s->f[i] + s->f_old[i]);
-        for (int r = 0; r < 4; ++r) {
-            double acc = 0.0;
-            for (int j = 0; j < DOP_STAGES_EXT; ++j) acc += DOP_D[r * DOP_STAGES_EXT + j] * s->K[j][i];
-            s->F[3 + r][i] = h * acc;
+    }
+    for (int r = 0; r < 4; ++r) {
+        const double *d = DOP_D + r * DOP_STAGES_EXT;
+        for (int i = 0; i < n; ++i) acc[i] = 0.0;
+        for (int j = 0; j < DOP_STAGES_EXT; ++j) {
+            const double c = d[j];
+            if (c == 0.0) continue;
+            for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
         }
+        for (int i = 0; i < n; ++i) s->F[3 + r][i] = h * acc[i];
     }
     s->dense_ready = 1;
     return 0;
 }
 
+/* The dense output at t: Horner in x and 1 - x, all components side by side. */
 static void dop_dense_eval(const Dop *s, double t, double *out) {
     const int n = DOP_N(s);
-    double x = (t - s->t_old) / s->h;
-    for (int i = 0; i < n; ++i) {
-        double y = 0.0;
-        for (int k = DOP_INTERP - 1, c = 0; k >= 0; --k, ++c) {
-            y += s->F[k][i];
-            y *= (c % 2 == 0) ? x : (1.0 - x);
-        }
-        out[i] = y + s->y_old[i];
+    const double x = (t - s->t_old) / s->h, y1 = 1.0 - x;
+    double y[NXMAX];
+    for (int i = 0; i < n; ++i) y[i] = 0.0;
+    for (int k = DOP_INTERP - 1, c = 0; k >= 0; --k, ++c) {
+        const double m = (c % 2 == 0) ? x : y1;
+        for (int i = 0; i < n; ++i) y[i] = (y[i] + s->F[k][i]) * m;
     }
+    for (int i = 0; i < n; ++i) out[i] = y[i] + s->y_old[i];
 }
 
 /* Cubic Hermite through both step ends: cheap, for spotting sign changes inside a step. */
