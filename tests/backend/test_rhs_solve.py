@@ -3,12 +3,12 @@ on the kernel's own M, h, Γ, for the unrolled LDLᵀ (small systems) and the lo
 
 import numpy as np
 import pytest
+from chains import pendulum_chain
 
 from amble import HybridSystem, Model
 from amble.backend import codegen
 from amble.backend.kernels import build
 from amble.models import load
-from chains import pendulum_chain
 
 
 def _check(k, n: int, rng: np.random.Generator, states: int = 20) -> None:

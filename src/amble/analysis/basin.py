@@ -19,10 +19,11 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.engine import Options, run
+from ..simulation.engine import Options, walk_many
 from .bifurcation import on_section
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
@@ -102,30 +103,26 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     xs = np.asarray(fixed, float)
     b0 = np.asarray(base, float)
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
+    # every valid cell of the task in one compiled call (amble_walk_batch): the walks and their
+    # convergence checks run in C with the GIL released, so threads and workers scale with cores
+    cells = [(i, a, j, b, np.asarray(to_state(a, b, b0), float)) for i, a in rows for j, b in enumerate(b_values)]
+    ok = [c for c in cells if c[4].shape == (n,) and np.all(np.isfinite(c[4]))]
+    walks = walk_many(k, p, mi, np.array([c[4] for c in ok]).reshape(len(ok), n), xs, steps=steps,
+                      check_every=check_every, tol=tol, opts=opts) if ok else None
+    result = {(c[0], c[2]): w for w, c in enumerate(ok)}
     out = []
-    for i, a in rows:
-        for j, b in enumerate(b_values):
-            x = np.asarray(to_state(a, b, b0), float)
-            done, code, dist, reason = 0, 0, math.nan, ""
-            if x.shape != (n,) or not np.all(np.isfinite(x)):
-                code, reason = 3, "invalid initial state"
+    for i, a, j, b, _x in cells:
+        w = result.get((i, j))
+        if w is None:
+            code, reason, done, dist = 3, "invalid initial state", 0, math.nan
+        else:
+            done, dist, status = int(walks["steps"][w]), float(walks["distance"][w]), walks["status"][w]
+            if walks["code"][w] != CODE["STEPS_DONE"]:
+                code, reason = (1 if status == "fell" else 3), status
             else:
-                while done < steps:
-                    m = min(check_every, steps - done)
-                    r = run(k, p, mi, x, steps=m, opts=opts)
-                    if not r.completed:
-                        done += r.steps
-                        code, reason = (1 if r.status == "fell" else 3), r.status
-                        break
-                    done += m
-                    x = r.x
-                    dist = float(np.max(np.abs(x - xs)))
-                    if dist < tol:
-                        break
-                if not reason:
-                    code = 0 if dist < tol else 2
-            out.append({"i": i, "j": j, x_names[0]: float(a), x_names[1]: float(b), "outcome": BASIN_LABELS[code],
-                        "reason": reason, "steps": done, "distance": dist})
+                code, reason = (0 if dist < tol else 2), ""
+        out.append({"i": i, "j": j, x_names[0]: float(a), x_names[1]: float(b), "outcome": BASIN_LABELS[code],
+                    "reason": reason, "steps": done, "distance": dist})
     return out
 
 

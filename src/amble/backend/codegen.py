@@ -94,7 +94,8 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     # small kernels are inlined into both callers (a call costs as much as their body); large ones
     # are compiled once, which is the point of emitting them once
     inline = "AMBLE_INLINE " if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
-    out = [f"static {inline}void mh_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n",
+    sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
+    out = [f"static {inline}void mh_{k}{sig} {{\n",
            "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n"]
     out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
             f"    double M[{n * n}], h[{n}], f[{n}];\n",
@@ -103,9 +104,10 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
             ldl_solve_code(n, "M", "f"),
             f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
             "    return 0;\n}\n"]
-    out += [f"static void dynamics_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n",
+    out += [f"static void dynamics_{k}{sig} {{\n",
             f"    mh_{k}(t, x, p, M, h, G);\n",
-            f"    for (int i = 0; i < {n}; ++i)\n        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
+            f"    for (int i = 0; i < {n}; ++i)\n",
+            f"        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
             "}\n"]
     return "".join(out)
 

@@ -255,3 +255,6 @@ void amble_info(int64_t *out) {
     out[5] = CX_X;
     out[6] = AMBLE_LAYOUT;
 }
+
+/* ---- many walks per call (basin maps, sweeps) ---- */
+#include "batch.h"
