@@ -24,34 +24,37 @@ def _square_of_trig(f: sp.Expr) -> tuple[Any, sp.Expr] | None:
 
 
 def _pair_up(terms: list[sp.Expr]) -> list[sp.Expr] | None:
-    """The terms of a sum with each pair ``r·sin²u``, ``r·cos²u`` replaced by ``r`` (``None``: no pair)."""
-    found: dict[tuple[Any, sp.Expr, sp.Expr], int] = {}
-    keyed: list[tuple[Any, sp.Expr, sp.Expr] | None] = []
+    """The terms of a sum with pairs ``r·sin²u``, ``r·cos²u`` replaced by ``r`` (``None``: no pair).
+    A term is indexed under every squared sine or cosine it has, so ``r`` may itself hold some."""
+    keys: list[list[tuple[Any, sp.Expr, sp.Expr]]] = []
+    where: dict[tuple[Any, sp.Expr, sp.Expr], list[int]] = {}
     for i, term in enumerate(terms):
-        key = None
         factors = sp.Mul.make_args(term)
+        mine = []
         for j, f in enumerate(factors):
             st = _square_of_trig(f)
             if st is not None:
                 key = (st[0], st[1], sp.Mul(*factors[:j], *factors[j + 1:]))
-                found.setdefault(key, i)
-                break
-        keyed.append(key)
-    out, used, changed = [], set(), False
+                mine.append(key)
+                where.setdefault(key, []).append(i)
+        keys.append(mine)
+    if not where:
+        return None
+    out, used = [], set()
     for i, term in enumerate(terms):
         if i in used:
             continue
-        key = keyed[i]
-        if key is not None:
-            other = sp.cos if key[0] is sp.sin else sp.sin
-            j = found.get((other, key[1], key[2]))
-            if j is not None and j not in used and j != i:
-                used.update((i, j))
-                out.append(key[2])
-                changed = True
-                continue
-        out.append(term)
-    return out if changed else None
+        partner = None
+        for func, arg, rest in keys[i]:
+            other = sp.cos if func is sp.sin else sp.sin
+            partner = next((j for j in where.get((other, arg, rest), ()) if j != i and j not in used), None)
+            if partner is not None:
+                used.update((i, partner))
+                out.append(rest)
+                break
+        if partner is None:
+            out.append(term)
+    return out if used else None
 
 
 def pythagoras(exprs: list[sp.Expr]) -> list[sp.Expr]:
