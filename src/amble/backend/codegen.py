@@ -148,7 +148,9 @@ def ldl_solve_code(n: int, a: str, b: str, indent: str = "    ") -> str:
     if n > 1:
         w(f"{ind}double dmin = d0, dmax = d0;")
         for j in range(1, n):
-            w(f"{ind}dmin = fmin(dmin, d{j}); dmax = fmax(dmax, d{j});")
+            # comparisons, not fmin/fmax: those are library calls at -O2 (NaN rules)
+            w(f"{ind}if (d{j} < dmin) dmin = d{j};")
+            w(f"{ind}if (d{j} > dmax) dmax = d{j};")
         w(f"{ind}if (dmax > 1e14 * dmin) return AMBLE_ERR_SINGULAR_MASS;")
     for i in range(1, n):  # L y = b
         w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(i, k)} * {b}[{k}]" for k in range(i)) + ";")
