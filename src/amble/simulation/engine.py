@@ -193,8 +193,11 @@ def _result(k: Kernels, code: int, ctx: np.ndarray, buf: _Buffers) -> Run:
 
 
 #: Sample rows and event rows the buffers of a recording run start with: a walk of a few hundred
-#: steps on a 0.01 s grid never regrows (each regrowth copies every row).
+#: steps on a 0.01 s grid never regrows (each regrowth copies every row). Sample buffers start at
+#: no more than :data:`_FIRST_BYTES` (a long state vector starts with fewer rows), which bounds
+#: what a thread keeps for its next run.
 _FIRST_ROWS = 1 << 15
+_FIRST_BYTES = 4 * 2**20
 _FIRST_EVENTS = 256
 
 #: Buffers of finished runs, per thread, ready for the next run of the same shape: a fresh
@@ -206,7 +209,8 @@ _FREE = threading.local()
 
 def _first_rows(nxm: int, budget: int) -> int:
     """Sample rows to start with: :data:`_FIRST_ROWS`, or fewer if a small budget asks for it."""
-    return max(16, min(_FIRST_ROWS, budget // (4 * (8 + 4 + 8 * nxm))))
+    row = 8 + 4 + 8 * nxm
+    return max(16, min(_FIRST_ROWS, _FIRST_BYTES // row, budget // (4 * row)))
 
 
 class _Buffers:
