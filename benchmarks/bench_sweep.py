@@ -1,4 +1,11 @@
-"""Benchmark: a 100 × 100 basin map of the compass gait on 1 and 2 Dask LocalCluster workers.
+"""Benchmark: basin maps of the compass gait in one process on 1 and 2 threads, and on 1 and 2
+Dask LocalCluster workers.
+
+In-process (:func:`threads`): the same cells walked one ``engine.run`` call per run of footfalls
+(the loop basin maps used before) and in blocks by ``engine.walk_many`` (one compiled call per
+block, ``amble_walk_batch``), each on a thread pool of 1 and 2 threads; throughput in walks per
+second, medians of interleaved repeats. The goal: the batched path scales ≥ 1.8× from 1 to 2
+threads.
 
 Run with ``python -m benchmarks.bench_sweep`` (not part of pytest). Grid: post-impact stance
 angle −0.35…−0.10 rad × stance angular velocity 0.8…1.4 rad/s (swing = 2·slope − stance, swing
@@ -13,7 +20,16 @@ and the throughput in initial conditions per second. The same map from the comma
 from __future__ import annotations
 
 import argparse
+import statistics
 import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from benchmarks.common import Goal, Section, table
+
+#: Goal: throughput of the batched path on 2 threads ÷ on 1 thread.
+GOAL_SCALING = 1.8
 
 
 def _warm(system) -> None:
@@ -40,6 +56,106 @@ def _one(system, n: int, workers: int, steps: int) -> tuple[float, float, dict[s
         cluster.close()
     t2 = time.perf_counter()
     return t1 - t0, t2 - t1, res.counts()
+
+
+def _cells(system, n: int):
+    """(kernels, parameters, fixed point, n² initial post-impact states around the fixed point)."""
+    from amble.analysis.poincare import find_fixed_point
+    from amble.backend.kernels import build
+    from amble.simulation.simulate import parameter_vector
+
+    k = build(system)
+    p = parameter_vector(k, {"slope": 0.05})
+    xs = find_fixed_point(system, params={"slope": 0.05}).fixed_point
+    a, b = np.meshgrid(np.linspace(-0.35, -0.10, n), np.linspace(0.8, 1.4, n), indexing="ij")
+    x0 = np.tile(xs, (n * n, 1))
+    x0[:, 0], x0[:, 2] = a.ravel(), -b.ravel() if xs[2] < 0 else b.ravel()
+    x0[:, 1] = 2 * 0.05 - x0[:, 0]  # both feet on the slope
+    return k, p, xs, x0
+
+
+def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
+    """Walks per second of the one-call-per-run loop and of the batched path on 1 and 2 threads."""
+    from amble.analysis.defaults import BASIN_TOL
+    from amble.models import load
+    from amble.simulation.engine import Options, run, walk_many
+
+    system = load("compass-gait")
+    n, steps, every, tol, block = (12, 30, 5, 1e-4, 16) if quick else (24, 60, 5, 1e-4, 16)
+    k, p, xs, x0 = _cells(system, n)
+    opts = Options(rtol=BASIN_TOL, atol=BASIN_TOL, max_step_time=system.max_step_time)
+    blocks = [x0[i:i + block] for i in range(0, len(x0), block)]
+
+    def loop(xb):  # the per-walk Python loop (as basin cells ran before amble_walk_batch)
+        for x in xb:
+            done = 0
+            while done < steps:
+                r = run(k, p, 0, x, steps=min(every, steps - done), opts=opts)
+                if not r.completed:
+                    break
+                done += every
+                x = r.x
+                if float(np.max(np.abs(x - xs))) < tol:
+                    break
+
+    def batched(xb):
+        walk_many(k, p, 0, xb, xs, steps=steps, check_every=every, tol=tol, opts=opts)
+
+    paths = {"one call per run (Python loop)": loop, "batched (`walk_many`)": batched}
+    times: dict[tuple[str, int], list[float]] = {(name, w): [] for name in paths for w in (1, 2)}
+    pools = {w: ThreadPoolExecutor(w) for w in (1, 2)}
+    try:
+        for fn in paths.values():
+            list(pools[1].map(fn, blocks[:2]))  # warm-up
+        for _ in range(3 if quick else 5):
+            for name, fn in paths.items():
+                for w in (1, 2):
+                    t0 = time.perf_counter()
+                    list(pools[w].map(fn, blocks))
+                    times[(name, w)].append(time.perf_counter() - t0)
+    finally:
+        for pool in pools.values():
+            pool.shutdown()
+    rows, data, goals = [], {}, []
+    for name in paths:
+        t1, t2 = statistics.median(times[(name, 1)]), statistics.median(times[(name, 2)])
+        data[name] = {"1": len(x0) / t1, "2": len(x0) / t2, "scaling": t1 / t2}
+        rows.append([name, f"{len(x0) / t1:,.0f}", f"{len(x0) / t2:,.0f}", f"{len(x0) / t2 / 2:,.0f}",
+                     f"{t1 / t2:.2f}×"])
+    sc = data["batched (`walk_many`)"]["scaling"]
+    goals.append(Goal("basin cells, batched, 2 threads ÷ 1 thread (in-process)", f"≥ {GOAL_SCALING:g}×",
+                      f"{sc:.2f}× (Python loop: {data['one call per run (Python loop)']['scaling']:.2f}×)",
+                      sc >= GOAL_SCALING))
+    md = (f"{n} × {n} compass-gait basin cells (≤ {steps} footfalls, checked every {every}, rtol = atol = "
+          f"{BASIN_TOL:g}), blocks of {block} cells on a thread pool; medians of "
+          f"{3 if quick else 5} interleaved repeats.\n\n"
+          + table(["path", "walks/s, 1 thread", "walks/s, 2 threads", "per core, 2 threads", "2 ÷ 1"], rows))
+    return md, goals, data
+
+
+def run(quick: bool = False) -> Section:
+    """In-process thread scaling; with a full run also the Dask LocalCluster basin map."""
+    md, goals, data = threads(quick)
+    parts = ["### In one process: 1 and 2 threads", "", md]
+    if not quick:
+        from amble.backend.kernels import build
+        from amble.models import load
+
+        system = load("compass-gait")
+        build(system)
+        n, steps = 100, 60
+        cells = n * n
+        rows = []
+        for w in (1, 2):
+            start, t_map, _ = _one(system, n, w, steps)
+            data[f"dask_{w}"] = {"start_s": start, "map_s": t_map}
+            rows.append([str(w), f"{start:.2f} s", f"{t_map:.2f} s", f"{cells / t_map:,.0f}",
+                         f"{cells / t_map / w:,.0f}"])
+        parts += ["", f"### Dask LocalCluster: {n} × {n} basin map, ≤ {steps} footfalls per cell", "",
+                  table(["workers", "start-up", "map", "cells/s", "cells/s per worker"], rows)]
+        sp = data["dask_1"]["map_s"] / data["dask_2"]["map_s"]
+        goals.append(Goal("basin map, Dask 2 workers ÷ 1 worker", "(reported)", f"{sp:.2f}×", None))
+    return Section("Basin maps and sweeps: scaling with cores", "\n".join(parts), goals, data)
 
 
 def main() -> None:

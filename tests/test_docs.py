@@ -15,7 +15,8 @@ ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 # Pages whose ```python blocks form one runnable script each (```py blocks are illustrative only).
 RUNNABLE = ["index.md", "guide/modeling.md", "guide/hybrid.md", "guide/simulation.md", "guide/analysis.md",
-            "guide/visualisation.md", "guide/controlled-walking.md", "guide/gait-optimisation.md"]
+            "guide/visualisation.md", "guide/controlled-walking.md", "guide/gait-optimisation.md",
+            "guide/performance.md"]
 
 
 def _generator():

@@ -19,10 +19,11 @@ from typing import Any
 
 import numpy as np
 
+from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import ConvergenceError, StateError
 from ..modelling.hybrid import HybridSystem
-from ..simulation.engine import Options, run
+from ..simulation.engine import Options, walk_many
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
 from .section import Section
@@ -104,35 +105,35 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
         idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
         to_state = _embed(k, p, None if section is None else tuple(section[:3]), idx,
                           [] if section is None else section[3])
-    out = []
+    cells = []  # (i, a, j, b, state or None, reason it has none)
     for i, a in rows:
         for j, b in enumerate(b_values):
-            done, code, dist, reason = 0, 0, math.nan, ""
             try:
                 x = np.asarray(to_state(a, b, b0), float)
             except ConvergenceError:  # no state of the section has these two coordinates here
-                x, code, reason = None, 3, "off the section"
-            if x is None:
-                pass
-            elif x.shape != (n,) or not np.all(np.isfinite(x)):
-                code, reason = 3, "invalid initial state"
+                cells.append((i, a, j, b, None, "off the section"))
+                continue
+            ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
+            cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
+    # every valid cell of the task in one compiled call (amble_walk_batch): the walks and their
+    # convergence checks run in C with the GIL released, so threads and workers scale with cores
+    valid = [c for c in cells if c[4] is not None]
+    walks = walk_many(k, p, mi, np.array([c[4] for c in valid]).reshape(len(valid), n), xs, steps=steps,
+                      check_every=check_every, tol=tol, opts=opts) if valid else None
+    result = {(c[0], c[2]): w for w, c in enumerate(valid)}
+    out = []
+    for i, a, j, b, _x, why in cells:
+        w = result.get((i, j))
+        if w is None:
+            code, reason, done, dist = 3, why, 0, math.nan
+        else:
+            done, dist, status = int(walks["steps"][w]), float(walks["distance"][w]), walks["status"][w]
+            if walks["code"][w] != CODE["STEPS_DONE"]:
+                code, reason = (1 if status == "fell" else 3), status
             else:
-                while done < steps:
-                    m = min(check_every, steps - done)
-                    r = run(k, p, mi, x, steps=m, opts=opts)
-                    if not r.completed:
-                        done += r.steps
-                        code, reason = (1 if r.status == "fell" else 3), r.status
-                        break
-                    done += m
-                    x = r.x
-                    dist = float(np.max(np.abs(x - xs)))
-                    if dist < tol:
-                        break
-                if not reason:
-                    code = 0 if dist < tol else 2
-            out.append({"i": i, "j": j, x_names[0]: float(a), x_names[1]: float(b), "outcome": BASIN_LABELS[code],
-                        "reason": reason, "steps": done, "distance": dist})
+                code, reason = (0 if dist < tol else 2), ""
+        out.append({"i": i, "j": j, x_names[0]: float(a), x_names[1]: float(b), "outcome": BASIN_LABELS[code],
+                    "reason": reason, "steps": done, "distance": dist})
     return out
 
 

@@ -27,7 +27,88 @@ from .codegen_support import Printer as _Printer
 from .codegen_support import block as _block
 from .codegen_support import bool_expr as _bool_block
 from .codegen_support import symbol_names as _names
+from .trig import pythagoras
 from .variational_codegen import derivative_kernels, derivative_stubs
+
+
+def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, nm: dict[sp.Symbol, str],
+                   prelude: str) -> str:
+    """``mh_k`` (the lower triangle of M, h and Γ — emitted once: for a large tree it is most of
+    the unit and of the compile time), and the two kernels that use it: ``rhs_k`` (q̈ = M⁻¹ (Γ − h)
+    by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display)."""
+    tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)] + [f"h[{i}]" for i in range(n)]
+    tg += [f"G[{i}]" for i in range(n)]
+    ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
+    ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
+    # small kernels are inlined into both callers (a call costs as much as their body); large ones
+    # are compiled once, which is the point of emitting them once
+    inline = "AMBLE_INLINE " if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
+    sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
+    out = [f"static {inline}void mh_{k}{sig} {{\n",
+           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n"]
+    out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
+            f"    double M[{n * n}], h[{n}], f[{n}];\n",
+            f"    mh_{k}(t, x, p, M, h, f);\n",
+            f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
+            ldl_solve_code(n, "M", "f"),
+            f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
+            "    return 0;\n}\n"]
+    out += [f"static void dynamics_{k}{sig} {{\n",
+            f"    mh_{k}(t, x, p, M, h, G);\n",
+            f"    for (int i = 0; i < {n}; ++i)\n",
+            f"        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
+            "}\n"]
+    return "".join(out)
+
+
+#: Largest ``mh_k`` (operations of M, h, Γ) that is forced inline into ``rhs_k`` and ``dynamics_k``.
+INLINE_OPS = 400
+
+#: Largest system whose LDLᵀ solve is written out statement by statement; larger ones call the
+#: loop in ``amble_core.h`` (unrolled code grows as n³/6 and so does its compile time).
+UNROLL_MAX = 12
+
+
+def ldl_solve_code(n: int, a: str, b: str, indent: str = "    ") -> str:
+    """C statements solving ``a x = b`` in place for a symmetric positive definite ``a`` (row-major
+    n × n, lower triangle read and overwritten by the unit lower factor L; ``b`` overwritten by x),
+    returning ``AMBLE_ERR_SINGULAR_MASS`` from the enclosing function if a pivot is not positive or
+    the pivots spread by more than 1e14 (the same test as ``amble_chol_solve``: cond(A) is at least
+    max D / min D). LDLᵀ needs no square root; up to :data:`UNROLL_MAX` the loops are unrolled so
+    every index is a constant."""
+    if n > UNROLL_MAX:
+        return f"{indent}if (amble_ldl_solve({n}, {a}, {b})) return AMBLE_ERR_SINGULAR_MASS;\n"
+    A = lambda i, j: f"{a}[{i * n + j}]"
+    L: list[str] = []
+    w = L.append
+    w(f"{indent}{{\n")
+    ind = indent + "    "
+    for j in range(n):
+        # u_k = L[j,k] D_k (k < j) are reused by every row below j
+        for k in range(j):
+            w(f"{ind}const double u{j}_{k} = {A(j, k)} * d{k};")
+        s = " - ".join([A(j, j)] + [f"{A(j, k)} * u{j}_{k}" for k in range(j)])
+        w(f"{ind}const double d{j} = {s};")
+        w(f"{ind}if (!(d{j} > 0.0)) return AMBLE_ERR_SINGULAR_MASS;")
+        w(f"{ind}const double r{j} = 1.0 / d{j};")  # one division per pivot, none in the solve
+        for i in range(j + 1, n):
+            s = " - ".join([A(i, j)] + [f"{A(i, k)} * u{j}_{k}" for k in range(j)])
+            w(f"{ind}{A(i, j)} = ({s}) * r{j};")
+    if n > 1:
+        w(f"{ind}double dmin = d0, dmax = d0;")
+        for j in range(1, n):
+            # comparisons, not fmin/fmax: those are library calls at -O2 (NaN rules)
+            w(f"{ind}if (d{j} < dmin) dmin = d{j};")
+            w(f"{ind}if (d{j} > dmax) dmax = d{j};")
+        w(f"{ind}if (dmax > 1e14 * dmin) return AMBLE_ERR_SINGULAR_MASS;")
+    for i in range(1, n):  # L y = b
+        w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(i, k)} * {b}[{k}]" for k in range(i)) + ";")
+    for i in range(n):  # D z = y
+        w(f"{ind}{b}[{i}] *= r{i};")
+    for i in range(n - 2, -1, -1):  # Lᵀ x = z
+        w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(k, i)} * {b}[{k}]" for k in range(i + 1, n)) + ";")
+    w(f"{indent}}}")
+    return "\n".join(L) + "\n"
 
 
 def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict]:
@@ -56,6 +137,8 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
     w('#include "amble_core.h"\n')
     w(abi.c_header())
     w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
+    if len(set(nx)) == 1:  # one state length: the integrator's loops get constant trip counts
+        w(f"#define NX_FIXED {nx[0]}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
     w("#define SC (NXMAX + NPARAM)\n")  # columns of a sensitivity row: state, then parameters
     w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
@@ -78,25 +161,7 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
         pr = _Printer(nm)
         prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
-        # right-hand side: q̈ = M⁻¹ (Γ − h)
-        tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)]
-        ex = [eqM[i, j] for i in range(n) for j in range(i + 1)]
-        tg += [f"f[{i}]" for i in range(n)]
-        ex += [eq.closed_loop_force[i] - eqh[i] for i in range(n)]
-        w(f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n")
-        w(f"    double M[{n * n}], f[{n}];\n    (void)t; (void)p;\n")
-        w(_block(tg, ex, nm, prelude=prelude))
-        w(f"    int err = amble_chol_solve({n}, M, f);\n")
-        w(f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n")
-        w("    return err;\n}\n")
-        # M, h and Γ separately (analysis and display; the integrator uses rhs above)
-        tg = [f"M[{i * n + j}]" for i in range(n) for j in range(n)] + [f"h[{i}]" for i in range(n)]
-        tg += [f"G[{i}]" for i in range(n)]
-        ex = [eqM[i, j] for i in range(n) for j in range(n)] + list(eqh) + list(eq.closed_loop_force)
-        w(f"static void dynamics_{k}(double t, const double *x, const double *p, double *M, double *h, double *G) {{\n")
-        w("    (void)t; (void)p;\n")
-        w(_block(tg, ex, nm, prelude=prelude))
-        w("}\n")
+        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude))
         # guards of this mode's transitions
         trs = trs_by_mode[name]
         w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")

@@ -108,6 +108,10 @@ class Kernels:
         lib.amble_reset_jac.restype = ctypes.c_int
         lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         self.simulate_raw = lib.amble_simulate
+        lib.amble_walk_batch.restype = None
+        lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_int] + [ctypes.c_void_p] * 5 + \
+            [ctypes.c_int64, ctypes.c_int64, ctypes.c_double] + [ctypes.c_void_p] * 5
+        self._walk_batch = lib.amble_walk_batch
 
     # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
     def mode_index(self, mode: str | int) -> int:
@@ -211,6 +215,35 @@ class Kernels:
             raise ModelError(f"reset of {trs[transition]['name']!r} failed (singular impulse system)")
         npar = len(self.meta["params"])
         return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + npar].copy(), D[:nd, self.sc].copy()
+
+    def walk_batch(self, mode: str | int, x0: np.ndarray, p: np.ndarray, opt: np.ndarray, iopt: np.ndarray,
+                   xref: np.ndarray, steps: int, check_every: int, tol: float) -> dict[str, np.ndarray]:
+        """Walk every row of ``x0`` (initial states of ``mode`` at t = 0) for up to ``steps``
+        footfalls in one compiled call (which releases the GIL), in runs of ``check_every``
+        footfalls each started afresh from the last one's final state, stopping a walk when
+        ``max |x − xref| < tol`` after a run. ``opt``/``iopt``: the run option layouts of
+        :mod:`amble.backend.abi` (capacities ignored: nothing is recorded). Returns per walk:
+        ``code`` (status of its last run), ``info`` (the transition that ended it, or −1),
+        ``steps`` (footfalls taken), ``distance`` (after the last completed run; NaN if none) and
+        ``x`` (final states, NaN-padded to ``nx_max``)."""
+        mi = self.mode_index(mode)
+        nx = self.meta["nx"][mi]
+        x0 = np.asarray(x0, dtype=float)
+        if x0.ndim != 2 or x0.shape[1] != nx:
+            raise StateError(f"initial states must be rows of {nx} entries, got shape {x0.shape}")
+        xref = _vec(xref, nx)
+        n = x0.shape[0]
+        xs = np.full((n, self.nx_max), np.nan)
+        xs[:, :nx] = x0
+        opt = np.ascontiguousarray(opt, dtype=float)
+        iopt = np.ascontiguousarray(iopt, dtype=np.int64)
+        p = np.ascontiguousarray(p, dtype=float)
+        out = {"code": np.zeros(n, dtype=np.int32), "info": np.zeros(n, dtype=np.int32),
+               "steps": np.zeros(n, dtype=np.int64), "distance": np.zeros(n), "x": np.zeros((n, self.nx_max))}
+        addr = lambda a: a.ctypes.data  # noqa: E731
+        self._walk_batch(n, mi, addr(xs), addr(p), addr(opt), addr(iopt), addr(xref), int(steps), int(check_every),
+                         float(tol), *(addr(out[k]) for k in ("code", "info", "steps", "distance", "x")))
+        return out
 
     def energy_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         t, modes, x = _rows(t, modes, x, self.nx_max, self.n_modes)

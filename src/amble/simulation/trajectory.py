@@ -22,9 +22,10 @@ if TYPE_CHECKING:
     from ..backend.kernels import Kernels
 
 
-@dataclass
+@dataclass(slots=True)
 class Event:
-    """One transition: when, which, and the state just before and just after it."""
+    """One transition: when, which, and the state just before and just after it (views of
+    the run's own event rows)."""
 
     t: float
     name: str

@@ -10,6 +10,13 @@
 #include <stdbool.h> /* derivatives of saturations print `true`/`false` conditions */
 #include <string.h>
 
+/* Inline a small generated function into every caller (the compiler's own choice otherwise). */
+#if defined(__GNUC__) || defined(__clang__)
+#define AMBLE_INLINE inline __attribute__((always_inline))
+#else
+#define AMBLE_INLINE inline
+#endif
+
 /* Error codes returned by kernels (0 = ok). */
 #define AMBLE_ERR_SINGULAR_MASS 1
 #define AMBLE_ERR_SINGULAR_RESET 2
@@ -45,6 +52,45 @@ static int amble_chol_solve(int n, double *A, double *b) {
         double v = b[i];
         for (int k = i + 1; k < n; ++k) v -= A[k * n + i] * b[k];
         b[i] = v / A[i * n + i];
+    }
+    return 0;
+}
+
+/* The same solve by LDL^T (A = L D L^T, L unit lower triangular): no square root, and the same
+ * failure test as amble_chol_solve (a pivot D_j not positive, or max D / min D > 1e14, a lower
+ * bound of cond(A)). The lower triangle of A is overwritten by L, b by x. Generated right-hand
+ * sides of small systems write this solve out unrolled (backend/codegen.py); larger ones call it. */
+static int amble_ldl_solve(int n, double *A, double *b) {
+    double D[n], u[n];
+    double dmin = INFINITY, dmax = 0.0;
+    for (int j = 0; j < n; ++j) {
+        double d = A[j * n + j];
+        for (int k = 0; k < j; ++k) {
+            u[k] = A[j * n + k] * D[k];
+            d -= A[j * n + k] * u[k];
+        }
+        if (!(d > 0.0)) return AMBLE_ERR_SINGULAR_MASS;
+        D[j] = d;
+        if (d < dmin) dmin = d;
+        if (d > dmax) dmax = d;
+        const double r = 1.0 / d;
+        for (int i = j + 1; i < n; ++i) {
+            double v = A[i * n + j];
+            for (int k = 0; k < j; ++k) v -= A[i * n + k] * u[k];
+            A[i * n + j] = v * r;
+        }
+    }
+    if (dmax > 1e14 * dmin) return AMBLE_ERR_SINGULAR_MASS;
+    for (int i = 1; i < n; ++i) {
+        double v = b[i];
+        for (int k = 0; k < i; ++k) v -= A[i * n + k] * b[k];
+        b[i] = v;
+    }
+    for (int i = 0; i < n; ++i) b[i] /= D[i];
+    for (int i = n - 2; i >= 0; --i) {
+        double v = b[i];
+        for (int k = i + 1; k < n; ++k) v -= A[k * n + i] * b[k];
+        b[i] = v;
     }
     return 0;
 }

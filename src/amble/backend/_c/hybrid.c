@@ -294,3 +294,6 @@ void amble_info(int64_t *out) {
     out[6] = AMBLE_LAYOUT;
     out[7] = SC;
 }
+
+/* ---- many walks per call (basin maps, sweeps) ---- */
+#include "batch.h"
