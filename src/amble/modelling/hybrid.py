@@ -116,6 +116,12 @@ class Transition:
     reset: Reset | None
     terminal: str | None = None
     step: bool = False
+    #: name of the transition taken instead of ending the run as ``zeno`` when firings of this
+    #: one accumulate (a unilateral contact coming to rest); None: the run ends as ``zeno``
+    rest: str | None = None
+    #: True: the transition has no guard crossing of its own; it is only taken as another
+    #: transition's ``rest`` (its guard is the constant 1, which never crosses)
+    forced: bool = False
 
 
 @dataclass
@@ -190,6 +196,41 @@ class HybridSystem:
             self.transitions.append(tr)
         assert tr is not None
         return tr
+
+    def add_mode(self, name: str, model: Model) -> None:
+        """Add a mode (e.g. the constrained mode of a resting contact)."""
+        if name in self.modes:
+            raise ModelError(f"system {self.name!r}: a mode named {name!r} exists already")
+        if model.dims != self.dims:
+            raise ModelError(f"system {self.name!r}: mode {name!r} mixes 2D and 3D models")
+        self.modes[name] = model
+        _ = self.parameters  # validates consistent defaults
+
+    def resting_contact(self, name: str, free: str, rest: str, gap: Any, impact: Reset, settle: Reset,
+                        force: Any, leave: Reset) -> tuple[Transition, Transition, Transition]:
+        """Declare the three transitions of a unilateral contact (usually built by
+        :func:`amble.unilateral_contact`, which derives them):
+
+        * ``name`` (``free → free``): the gap ``g(q, t)`` reaches zero falling; reset ``impact``;
+        * ``<name>_rest`` (``free → rest``): no guard; taken instead of ending the run as
+          ``zeno`` when the impacts accumulate (``Options.zeno_events`` of them closer than
+          ``Options.zeno_dt``; with restitution 0 they repeat at once); reset ``settle``;
+        * ``<name>_liftoff`` (``rest → free``): the contact force ``force`` (N, ``≥ 0`` while
+          held) falls through zero; reset ``leave``. ``force`` may be constant (it never lifts off).
+        """
+        self._check_mode(free)
+        self._check_mode(rest)
+        hit = self.transition(name, free, Guard(gap, -1), impact)
+        _check_reset(self.modes[free], self.modes[rest], settle, f"{name}_rest")
+        settle_tr = Transition(f"{name}_rest", free, rest, Guard(sp.Integer(1)), settle, forced=True)
+        lift = Guard(force, -1)
+        if sp.sympify(force).free_symbols & (set(self.modes[rest].q) | set(self.modes[rest].qd)):
+            self._check_guard(rest, lift)
+        _check_reset(self.modes[rest], self.modes[free], leave, f"{name}_liftoff")
+        lift_tr = Transition(f"{name}_liftoff", rest, free, lift, leave)
+        hit.rest = settle_tr.name
+        self.transitions += [settle_tr, lift_tr]
+        return hit, settle_tr, lift_tr
 
     # ------------------------------------------------------------------ queries
     @property
