@@ -233,14 +233,15 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             status = ST_SLIDING;
             break;
         }
-        if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) {
-            /* sensitivities are not carried through a rest transition: such a run ends as zeno */
-            if (TR_REST[tr] < 0 || sens) { status = ST_ZENO; break; }
+        /* a contact whose impacts accumulate, or that leaves the impact without normal velocity,
+         * comes to rest; sensitivities are not carried through that transition (zeno instead) */
+        if (TR_REST[tr] >= 0 && !sens && ((zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) || settled(fired, s.n, s.y_old, g_old, gd_old))) {
             if ((st = come_to_rest(tr, t, p, &s, &mode, ctx, &rec, recording, ev_recording, g_old, gd_old)) >= 0) {
                 status = st;
                 break;
             }
         }
+        if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) { status = ST_ZENO; break; }
         if (max_steps > 0 && ctx[CX_STEPS] >= max_steps) { status = ST_STEPS_DONE; break; }
         if (max_events > 0 && ctx[CX_EVENTS] >= max_events) { status = ST_MAX_EVENTS; break; }
     }

@@ -1,0 +1,101 @@
+"""Resting contact (issue 15): a unilateral contact declared with ``unilateral_contact`` bounces
+with restitution, comes to rest in its constrained mode when the impacts accumulate (or at once
+with e = 0), and lifts off when the contact force would turn negative. Closed forms: the Zeno
+time of a bouncing ball, free fall, and the force of a point held on a table."""
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import amble
+from amble import HybridSystem, Model, ModelError, t
+
+G = 9.81
+
+
+def _ball(name: str, table=None):
+    m = Model(name)
+    x, z = m.coordinates("x z")
+    mass, g, e, jerk = m.parameters(mass=2.0, g=G, e=0.5, jerk=4.0)
+    m.point("p", (x, z), mass=mass)
+    m.gravity(g)
+    s = HybridSystem(name, m)
+    gap = z if table is None else z - table(jerk)
+    amble.unilateral_contact(s, "floor", name, gap, e)
+    return s, m, gap
+
+
+@pytest.mark.parametrize("e", [0.5, 0.7])
+def test_a_bouncing_ball_rests_at_the_zeno_time_and_the_run_continues(e):
+    s, _, _ = _ball("rc-ball")
+    h = 1.0
+    tr = amble.simulate(s, [0.0, h, 0.0, 0.0], params={"e": e}, t_end=6.0)
+    assert tr.status == "end_time", tr.message
+    t_zeno = math.sqrt(2 * h / G) * (1 + 2 * e / (1 - e))
+    rest = [ev for ev in tr.events if ev.name == "floor_rest"]
+    assert len(rest) == 1 and rest[0].target == "rc-ball_floor"
+    assert rest[0].t == pytest.approx(t_zeno, rel=1e-6)
+    after = tr.t > rest[0].t
+    assert after.sum() > 1 and tr.t[-1] == pytest.approx(6.0)
+    assert np.max(np.abs(tr.x[after, 1])) < 1e-9 and np.max(np.abs(tr.x[after, 3])) < 1e-9
+
+
+def test_the_resting_force_is_the_weight():
+    _, m, gap = _ball("rc-ball")
+    mass, g = sp.Symbol("mass", real=True), sp.Symbol("g", real=True)
+    lam = amble.contact_force(m, gap)
+    assert sp.simplify(lam - mass * g) == 0
+
+
+def test_restitution_zero_lands_and_rests_at_once():
+    s, _, _ = _ball("rc-ball")
+    tr = amble.simulate(s, [0.0, 1.0, 0.0, 0.0], params={"e": 0.0}, t_end=3.0)
+    assert tr.status == "end_time", tr.message
+    assert [ev.name for ev in tr.events] == ["floor", "floor_rest"]
+    assert tr.events[-1].t == pytest.approx(math.sqrt(2 / G), abs=1e-9)
+    assert abs(tr.final_state[1]) < 1e-12 and tr.final_state[3] == 0.0
+
+
+@pytest.mark.parametrize("e", [0.0, 0.5])
+def test_a_point_released_on_the_floor_stays_on_it_and_slides(e):
+    s, _, _ = _ball("rc-ball")
+    tr = amble.simulate(s, [0.0, 0.0, 0.3, 0.0], params={"e": e}, t_end=3.0)
+    assert tr.status == "end_time", tr.message
+    assert tr.events[-1].name == "floor_rest" and tr.events[-1].t < 1e-12
+    x, z, xd, zd = tr.final_state
+    assert x == pytest.approx(0.9, rel=1e-12) and abs(z) < 1e-12 and zd == 0.0
+
+
+def test_a_table_accelerating_down_faster_than_g_lets_the_ball_lift_off():
+    # the table's height −j t³/6: its acceleration −j t exceeds g from t* = g/j on, where the
+    # contact force m (g − j t) turns negative; after that the ball falls freely
+    s, m, gap = _ball("rc-table", table=lambda j: -j * t**3 / 6)
+    jerk = 4.0
+    mass, g, j = (sp.Symbol(n, real=True) for n in ("mass", "g", "jerk"))
+    assert sp.simplify(amble.contact_force(m, gap) - mass * (g - j * t)) == 0
+    t_end = 4.0
+    tr = amble.simulate(s, [0.0, 0.0, 0.0, 0.0], t_end=t_end)
+    assert tr.status == "end_time", tr.message
+    assert [ev.name for ev in tr.events][-2:] == ["floor_rest", "floor_liftoff"]
+    ts = G / jerk
+    assert tr.events[-1].t == pytest.approx(ts, abs=1e-9)
+    zs, vs = -jerk * ts**3 / 6, -jerk * ts**2 / 2
+    assert tr.events[-1].x_pre[1] == pytest.approx(zs, rel=1e-9)
+    tau = t_end - ts
+    assert tr.final_state[1] == pytest.approx(zs + vs * tau - G / 2 * tau**2, rel=1e-9)
+    assert tr.final_state[3] == pytest.approx(vs - G * tau, rel=1e-9)
+
+
+def test_bad_contacts_are_model_errors():
+    m = Model("rc-bad")
+    x, z = m.coordinates("x z")
+    m.point("p", (x, z), mass=1.0)
+    s = HybridSystem("rc-bad", m)
+    with pytest.raises(ModelError, match="restitution"):
+        amble.unilateral_contact(s, "floor", "rc-bad", z, 1.5)
+    with pytest.raises(ModelError, match="does not depend"):
+        amble.unilateral_contact(s, "floor", "rc-bad", sp.Integer(1), 0.5)
+    with pytest.raises(ModelError, match="unknown mode"):
+        amble.unilateral_contact(s, "floor", "nope", z, 0.5)
