@@ -99,3 +99,17 @@ def test_bad_contacts_are_model_errors():
         amble.unilateral_contact(s, "floor", "rc-bad", sp.Integer(1), 0.5)
     with pytest.raises(ModelError, match="unknown mode"):
         amble.unilateral_contact(s, "floor", "nope", z, 0.5)
+
+
+def test_a_run_with_sensitivities_ends_as_zeno_at_the_rest_transition():
+    # the rest transition carries no saltation matrix: the run says where it stopped instead
+    from amble.backend.kernels import build
+    from amble.simulation.engine import Options, run
+    from amble.simulation.simulate import parameter_vector
+
+    s, _, _ = _ball("rc-ball")
+    k = build(s)
+    p = parameter_vector(k, {"e": 0.0}, s)
+    r = run(k, p, 0, np.array([0.0, 1.0, 0.0, 0.0]), t_end=3.0, opts=Options(), sensitivities=True)
+    assert r.status == "zeno"
+    assert r.t == pytest.approx(math.sqrt(2 / G), abs=1e-9)
