@@ -113,3 +113,68 @@ def test_a_run_with_sensitivities_ends_as_zeno_at_the_rest_transition():
     r = run(k, p, 0, np.array([0.0, 1.0, 0.0, 0.0]), t_end=3.0, opts=Options(), sensitivities=True)
     assert r.status == "zeno"
     assert r.t == pytest.approx(math.sqrt(2 / G), abs=1e-9)
+
+
+def test_a_point_released_on_an_incline_slides_down_it():
+    # gap along the unit normal of a frictionless plane descending along +x at angle γ: the point
+    # stays on it, slides with acceleration g sin γ and is held by m g cos γ
+    m = Model("rc-incline")
+    x, z = m.coordinates("x z")
+    mass, g, e, gamma = m.parameters(mass=2.0, g=G, e=0.3, gamma=0.3)
+    m.point("p", (x, z), mass=mass)
+    m.gravity(g)
+    s = HybridSystem("rc-incline", m)
+    gap = z * sp.cos(gamma) + x * sp.sin(gamma)
+    amble.unilateral_contact(s, "plane", "rc-incline", gap, e)
+    assert sp.simplify(amble.contact_force(m, gap) - mass * g * sp.cos(gamma)) == 0
+    tr = amble.simulate(s, [0.0, 0.0, 0.0, 0.0], t_end=2.0)
+    assert tr.status == "end_time", tr.message
+    assert tr.events[-1].name == "plane_rest"
+    dist = 0.5 * G * math.sin(0.3) * 2.0**2
+    xe, ze, _, _ = tr.final_state
+    assert xe == pytest.approx(dist * math.cos(0.3), rel=1e-9)
+    assert ze == pytest.approx(-dist * math.sin(0.3), rel=1e-9)
+
+
+@pytest.mark.parametrize("e", [1.0, 0.6])
+def test_the_impact_of_a_tumbling_rod_obeys_restitution_and_momentum(e):
+    # a rod of two point masses whose end A hits the floor: the impulse acts at A along the
+    # normal, so the horizontal momentum and the angular momentum about A are conserved, A's
+    # normal velocity becomes −e times what it was, and with e = 1 the kinetic energy is kept
+    m = Model("rc-rod")
+    xc, zc, th = m.coordinates("xc zc th")
+    mass, length, g, ee = m.parameters(mass=1.0, length=0.8, g=G, e=0.5)
+    a = (xc - length / 2 * sp.cos(th), zc - length / 2 * sp.sin(th))
+    b = (xc + length / 2 * sp.cos(th), zc + length / 2 * sp.sin(th))
+    m.point("A", a, mass=mass)
+    m.point("B", b, mass=mass)
+    m.gravity(g)
+    s = HybridSystem("rc-rod", m)
+    amble.unilateral_contact(s, "floor", "rc-rod", a[1], ee)
+    tr = amble.simulate(s, [0.0, 1.0, 0.6, 0.4, 0.0, 1.5], params={"e": e}, t_end=1.0)
+    ev = next(ev for ev in tr.events if ev.name == "floor")
+    L, mm = 0.8, 1.0
+
+    def points(x):
+        X, Z, T, Xd, Zd, Td = x
+        c, sn = math.cos(T), math.sin(T)
+        pa, va = np.array([X - L / 2 * c, Z - L / 2 * sn]), np.array([Xd + L / 2 * sn * Td, Zd - L / 2 * c * Td])
+        pb, vb = np.array([X + L / 2 * c, Z + L / 2 * sn]), np.array([Xd - L / 2 * sn * Td, Zd + L / 2 * c * Td])
+        return (pa, va), (pb, vb)
+
+    def laws(x, about):
+        (pa, va), (pb, vb) = points(x)
+        px = mm * (va[0] + vb[0])
+        ang = sum(mm * ((p - about)[0] * v[1] - (p - about)[1] * v[0]) for p, v in ((pa, va), (pb, vb)))
+        kin = 0.5 * mm * (va @ va + vb @ vb)
+        return px, ang, kin, va[1]
+
+    contact = points(ev.x_pre)[0][0]
+    px0, h0, k0, vn0 = laws(ev.x_pre, contact)
+    px1, h1, k1, vn1 = laws(ev.x_post, contact)
+    assert vn0 < 0 and vn1 == pytest.approx(-e * vn0, rel=1e-12)
+    assert px1 == pytest.approx(px0, abs=1e-12) and h1 == pytest.approx(h0, rel=1e-12)
+    if e == 1.0:
+        assert k1 == pytest.approx(k0, rel=1e-12)
+    else:
+        assert k1 < k0
