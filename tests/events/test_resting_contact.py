@@ -178,3 +178,17 @@ def test_the_impact_of_a_tumbling_rod_obeys_restitution_and_momentum(e):
         assert k1 == pytest.approx(k0, rel=1e-12)
     else:
         assert k1 < k0
+
+
+@pytest.mark.parametrize("opts", [amble.Options(method="radau"), amble.Options(zeno_events=0)],
+                         ids=["radau", "no-zeno-detector"])
+def test_the_ball_rests_with_the_implicit_integrator_and_without_the_zeno_detector(opts):
+    # without the detector the bounces go on until one leaves no normal velocity: that is the
+    # Zeno point itself, to round-off
+    s, _, _ = _ball("rc-ball")
+    tr = amble.simulate(s, [0.0, 1.0, 0.0, 0.0], t_end=3.0, options=opts)
+    assert tr.status == "end_time", tr.message
+    rest = [ev for ev in tr.events if ev.name == "floor_rest"]
+    t_zeno = math.sqrt(2 / G) * 3
+    assert rest[0].t == pytest.approx(t_zeno, rel=1e-9 if opts.zeno_events == 0 else 1e-6)
+    assert abs(tr.final_state[1]) < 1e-12 and tr.final_state[3] == 0.0
