@@ -35,6 +35,6 @@ __all__ = [
     "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
     "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
     "contact_force", "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
-    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate", "t", "unilateral_contact",
-    "vector", "walker",
+    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate", "t",
+    "unilateral_contact", "vector", "walker",
 ]
