@@ -192,3 +192,20 @@ def test_the_ball_rests_with_the_implicit_integrator_and_without_the_zeno_detect
     t_zeno = math.sqrt(2 / G) * 3
     assert rest[0].t == pytest.approx(t_zeno, rel=1e-9 if opts.zeno_events == 0 else 1e-6)
     assert abs(tr.final_state[1]) < 1e-12 and tr.final_state[3] == 0.0
+
+
+def test_a_plastic_landing_on_a_table_falling_faster_than_g_does_not_stick():
+    # dropped from 30 m, the ball meets the table (height −j t³/6) after t = g/j, when the table
+    # accelerates down faster than g: with e = 0 it takes the table's velocity and then falls
+    # freely behind it, never to touch again (held there, it would need a pulling force)
+    s, _, _ = _ball("rc-table", table=lambda j: -j * t**3 / 6)
+    jerk, z0, t_end = 4.0, 30.0, 6.0
+    tr = amble.simulate(s, [0.0, z0, 0.0, 0.0], params={"e": 0.0}, t_end=t_end)
+    assert tr.status == "end_time", tr.message
+    assert [ev.name for ev in tr.events] == ["floor"]
+    ti = tr.events[0].t
+    assert z0 - G * ti**2 / 2 == pytest.approx(-jerk * ti**3 / 6, abs=1e-9) and jerk * ti > G
+    zi, vi = -jerk * ti**3 / 6, -jerk * ti**2 / 2
+    assert tr.events[0].x_post[3] == pytest.approx(vi, rel=1e-12)
+    tau = t_end - ti
+    assert tr.final_state[1] == pytest.approx(zi + vi * tau - G / 2 * tau**2, rel=1e-9)

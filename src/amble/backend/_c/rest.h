@@ -8,14 +8,16 @@
 #ifndef AMBLE_REST_H
 #define AMBLE_REST_H
 
-/* After an impact of guard k (fired into its own mode, -1 otherwise): is the contact closed
- * with no normal velocity left — gap and its rate zero to the round-off of the state (the
- * threshold of arm_zero_guards)? Restitution 0 leaves it so; so does a point started on it. */
+/* After an impact of guard k (fired into its own mode, -1 otherwise; g after arm_zero_guards):
+ * is the contact closed with no normal velocity left (the rate zero to the round-off of the
+ * state, the threshold of arm_zero_guards) and does the flow press into it — arm_zero_guards
+ * then armed the guard to fire again at once (g = DBL_MIN)? Restitution 0 leaves a contact so,
+ * and so does a point started on it; where the flow pulls away the point leaves freely. */
 static int settled(int k, int n, const double *x, const double *g, const double *gd) {
     if (k < 0) return 0;
     double scale = 1.0;
     for (int i = 0; i < n; ++i) scale = fmax(scale, fabs(x[i]));
-    return fabs(g[k]) <= 1e-12 * scale && fabs(gd[k]) <= 1e-12 * scale;
+    return fabs(gd[k]) <= 1e-12 * scale && g[k] == DBL_MIN;
 }
 
 /* Take the rest transition of transition tr at time t from the state in s->y_old (mode *mode):
