@@ -209,3 +209,28 @@ def test_a_plastic_landing_on_a_table_falling_faster_than_g_does_not_stick():
     assert tr.events[0].x_post[3] == pytest.approx(vi, rel=1e-12)
     tau = t_end - ti
     assert tr.final_state[1] == pytest.approx(zi + vi * tau - G / 2 * tau**2, rel=1e-9)
+
+
+def test_a_rod_resting_on_one_end_falls_with_its_energy_and_centre_line_kept():
+    # a rod of two point masses standing on end A of a frictionless floor, released at rest:
+    # held by the derived contact force, A slides, the centre falls straight down (no horizontal
+    # force) and the energy is conserved (the static floor does no work)
+    m = Model("rc-rod")
+    xc, zc, th = m.coordinates("xc zc th")
+    mass, length, g, ee = m.parameters(mass=1.0, length=0.8, g=G, e=0.5)
+    a = (xc - length / 2 * sp.cos(th), zc - length / 2 * sp.sin(th))
+    m.point("A", a, mass=mass)
+    m.point("B", (xc + length / 2 * sp.cos(th), zc + length / 2 * sp.sin(th)), mass=mass)
+    m.gravity(g)
+    s = HybridSystem("rc-rod", m)
+    amble.unilateral_contact(s, "floor", "rc-rod", a[1], ee)
+    th0 = 1.4
+    tr = amble.simulate(s, [0.4 * math.cos(th0), 0.4 * math.sin(th0), th0, 0.0, 0.0, 0.0], t_end=0.6)
+    assert tr.status == "end_time", tr.message
+    assert [ev.name for ev in tr.events] == ["floor", "floor_rest"]
+    held = tr.t > tr.events[-1].t
+    assert tr.x[-1, 2] < 0.5  # it has fallen most of the way
+    assert np.max(np.abs(tr.x[held, 0] - 0.4 * math.cos(th0))) < 1e-9
+    assert np.max(np.abs(tr.x[held, 1] - 0.4 * np.sin(tr.x[held, 2]))) < 1e-8
+    total = tr.energy().sum(axis=1)
+    assert np.ptp(total[held]) < 1e-8 * (2 * 1.0 * G * 0.4)
