@@ -99,6 +99,9 @@ def test_bad_contacts_are_model_errors():
         amble.unilateral_contact(s, "floor", "rc-bad", sp.Integer(1), 0.5)
     with pytest.raises(ModelError, match="unknown mode"):
         amble.unilateral_contact(s, "floor", "nope", z, 0.5)
+    amble.unilateral_contact(s, "floor", "rc-bad", z, 0.5)
+    with pytest.raises(ModelError, match="exists already"):
+        amble.unilateral_contact(s, "floor", "rc-bad", z, 0.5)
 
 
 def test_a_run_with_sensitivities_ends_as_zeno_at_the_rest_transition():

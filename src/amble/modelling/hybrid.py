@@ -15,6 +15,11 @@ coordinates — and transitions between them. A transition has
     ``H_g``);
   or no reset and a terminal status (``fell``): the run ends there.
 
+A unilateral contact with restitution (``amble.unilateral_contact``, derived in
+:mod:`amble.derivation.resting`) adds a resting mode and three transitions declared by
+:meth:`HybridSystem.resting_contact`: the impact, the rest transition the compiled loop takes
+instead of a ``zeno`` end, and the lift-off.
+
 Everything here is a declaration; :mod:`amble.codegen` turns it into compiled code.
 """
 
@@ -27,6 +32,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError, ParameterError
+from .geometry import t as _T
 from .model import Model
 
 
@@ -214,22 +220,35 @@ class HybridSystem:
         * ``name`` (``free → free``): the gap ``g(q, t)`` reaches zero falling; reset ``impact``;
         * ``<name>_rest`` (``free → rest``): no guard; taken instead of ending the run as
           ``zeno`` when the impacts accumulate (``Options.zeno_events`` of them closer than
-          ``Options.zeno_dt``; with restitution 0 they repeat at once); reset ``settle``;
+          ``Options.zeno_dt``), or at once when an impact leaves no normal velocity while the
+          flow presses into the contact (restitution 0, a point started on it); reset ``settle``;
         * ``<name>_liftoff`` (``rest → free``): the contact force ``force`` (N, ``≥ 0`` while
           held) falls through zero; reset ``leave``. ``force`` may be constant (it never lifts off).
         """
         self._check_mode(free)
         self._check_mode(rest)
-        hit = self.transition(name, free, Guard(gap, -1), impact)
-        _check_reset(self.modes[free], self.modes[rest], settle, f"{name}_rest")
-        settle_tr = Transition(f"{name}_rest", free, rest, Guard(sp.Integer(1)), settle, forced=True)
-        lift = Guard(force, -1)
-        if sp.sympify(force).free_symbols & (set(self.modes[rest].q) | set(self.modes[rest].qd)):
+        taken = {tr.name for tr in self.transitions}
+        names = [name, f"{name}_rest", f"{name}_liftoff"]
+        if taken & set(names):
+            dup = sorted(taken & set(names))[0]
+            raise ModelError(f"system {self.name!r}: a transition named {dup!r} exists already")
+        hit_guard, lift = Guard(gap, -1), Guard(force, -1)
+        self._check_guard(free, hit_guard)
+        rest_model = self.modes[rest]
+        if sp.sympify(force).free_symbols & (set(rest_model.q) | set(rest_model.qd)):
             self._check_guard(rest, lift)
-        _check_reset(self.modes[rest], self.modes[free], leave, f"{name}_liftoff")
-        lift_tr = Transition(f"{name}_liftoff", rest, free, lift, leave)
-        hit.rest = settle_tr.name
-        self.transitions += [settle_tr, lift_tr]
+        else:  # a force of the parameters and time only (a point on a fixed floor: its weight)
+            bad = sorted(str(s_) for s_ in sp.sympify(force).free_symbols - set(rest_model.params) - {_T})
+            if bad:
+                raise ModelError(f"system {self.name!r}: the contact force of {name!r} uses unknown symbols "
+                                 f"{', '.join(bad)}")
+        _check_reset(self.modes[free], self.modes[free], impact, names[0])
+        _check_reset(self.modes[free], rest_model, settle, names[1])
+        _check_reset(rest_model, self.modes[free], leave, names[2])
+        hit = Transition(names[0], free, free, hit_guard, impact, rest=names[1])
+        settle_tr = Transition(names[1], free, rest, Guard(sp.Integer(1)), settle, forced=True)
+        lift_tr = Transition(names[2], rest, free, lift, leave)
+        self.transitions += [hit, settle_tr, lift_tr]
         return hit, settle_tr, lift_tr
 
     # ------------------------------------------------------------------ queries

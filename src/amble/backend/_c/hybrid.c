@@ -235,7 +235,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         }
         /* a contact whose impacts accumulate, or that leaves the impact without normal velocity,
          * comes to rest; sensitivities are not carried through that transition (zeno instead) */
-        if (TR_REST[tr] >= 0 && !sens && ((zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) || settled(fired, s.n, s.y_old, g_old, gd_old))) {
+        if (TR_REST[tr] >= 0 && !sens
+            && ((zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) || settled(fired, s.n, s.y_old, g_old, gd_old))) {
             if ((st = come_to_rest(tr, t, p, &s, &mode, ctx, &rec, recording, ev_recording, g_old, gd_old)) >= 0) {
                 status = st;
                 break;
