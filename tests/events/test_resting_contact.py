@@ -3,6 +3,7 @@ with restitution, comes to rest in its constrained mode when the impacts accumul
 with e = 0), and lifts off when the contact force would turn negative. Closed forms: the Zeno
 time of a bouncing ball, free fall, and the force of a point held on a table."""
 
+import json
 import math
 
 import numpy as np
@@ -237,3 +238,30 @@ def test_a_rod_resting_on_one_end_falls_with_its_energy_and_centre_line_kept():
     assert np.max(np.abs(tr.x[held, 1] - 0.4 * np.sin(tr.x[held, 2]))) < 1e-8
     total = tr.energy().sum(axis=1)
     assert np.ptp(total[held]) < 1e-8 * (2 * 1.0 * G * 0.4)
+
+
+BALL_FILE = """
+import amble
+from amble import HybridSystem, Model
+m = Model("ball")
+x, z = m.coordinates("x z")
+mass, g, e = m.parameters(mass=1.0, g=9.81, e=0.5)
+m.point("p", (x, z), mass=mass)
+m.gravity(g)
+system = HybridSystem("bouncing-ball", m)
+amble.unilateral_contact(system, "floor", "ball", z, e)
+"""
+
+
+def test_the_command_line_shows_the_resting_mode_and_runs_a_contact(tmp_path, capsys):
+    from amble.cli.main import main
+
+    f = tmp_path / "ball.py"
+    f.write_text(BALL_FILE)
+    assert main(["equations", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert "mode ball_floor" in out and "transition floor_rest: ball -> ball_floor" in out
+    assert "guard: none, taken when" in out and "guard: g*mass, falling" in out
+    assert main(["simulate", str(f), "--time", "2", "--start", "x0=0,1,0,0", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["status"] == "end_time", res
