@@ -5,6 +5,7 @@ impact maps, compiles them, simulates with exact events, and finds limit cycles.
 """
 
 from .derivation.equations import Equations, derive
+from .derivation.resting import contact_force, unilateral_contact
 from .errors import (
     AmbleError,
     CompileError,
@@ -33,7 +34,7 @@ __all__ = [
     "NONNEGATIVE", "POSITIVE", "R", "R3", "AmbleError", "CompileError", "ConvergenceError", "Domain", "Equations",
     "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
     "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
-    "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
+    "contact_force", "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
     "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate", "t",
-    "vector", "walker",
+    "unilateral_contact", "vector", "walker",
 ]

@@ -1,7 +1,8 @@
 """Finding 3 of issue 15 (partly): with restitution 0, or a ball released on the floor, the run
-fell through the floor silently (z = −447 m, status end_time). Resting contact is not modelled
-as a constrained mode yet; the run now ends at the floor as ``zeno`` (the impacts accumulate),
-at the closed-form landing time, instead of lying."""
+fell through the floor silently (z = −447 m, status end_time). A bounce written as a plain
+transition with an Explicit reset has no resting mode: the run ends at the floor as ``zeno`` (the
+impacts accumulate), at the closed-form landing time, instead of lying. Declared with
+``unilateral_contact`` it comes to rest and the run goes on (test_resting_contact.py)."""
 
 import math
 

@@ -150,7 +150,10 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
     arr = lambda vals: ", ".join(map(str, vals)) if vals else "0"
     w(f"static const int TR_DIR[NTR > 0 ? NTR : 1] = {{{arr([tr.guard.direction for tr in order])}}};\n")
     w(f"static const int TR_TERMINAL[NTR > 0 ? NTR : 1] = {{{arr([int(tr.terminal is not None) for tr in order])}}};\n")
-    w(f"static const int TR_STEP[NTR > 0 ? NTR : 1] = {{{arr([int(tr.step) for tr in order])}}};\n\n")
+    w(f"static const int TR_STEP[NTR > 0 ? NTR : 1] = {{{arr([int(tr.step) for tr in order])}}};\n")
+    # the transition taken instead of a zeno end when this one's firings accumulate (-1: none)
+    index = {tr.name: j for j, tr in enumerate(order)}
+    w(f"static const int TR_REST[NTR > 0 ? NTR : 1] = {{{arr([index.get(tr.rest, -1) for tr in order])}}};\n\n")
 
     for name, mi in modes.items():
         m, eq, k = mi.model, mi.equations, mi.index
@@ -284,6 +287,7 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
                 "target": tr.target,
                 "terminal": tr.terminal,
                 "step": tr.step,
+                "rest": tr.rest,
                 "shift": (tr.reset.shift_point if tr.reset is not None else None),
             }
             for tr in order

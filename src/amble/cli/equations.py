@@ -31,6 +31,9 @@ def _guard(tr, names: dict) -> dict[str, Any]:
     out = {"expr": _text(g.expr), "direction": g.direction, "when": _DIRECTION.get(g.direction, str(g.direction)),
            "enabled": None if g.enabled is None else _text(g.enabled)}
     out["latex"] = sp.latex(tidy(g.expr).subs(names))
+    if getattr(tr, "forced", False):  # a contact's rest transition: no crossing of its own
+        out.update(expr="none", latex=r"\text{none}",
+                   when="taken when the contact's impacts accumulate or one leaves no normal velocity")
     return out
 
 

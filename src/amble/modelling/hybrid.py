@@ -15,6 +15,11 @@ coordinates — and transitions between them. A transition has
     ``H_g``);
   or no reset and a terminal status (``fell``): the run ends there.
 
+A unilateral contact with restitution (``amble.unilateral_contact``, derived in
+:mod:`amble.derivation.resting`) adds a resting mode and three transitions declared by
+:meth:`HybridSystem.resting_contact`: the impact, the rest transition the compiled loop takes
+instead of a ``zeno`` end, and the lift-off.
+
 Everything here is a declaration; :mod:`amble.codegen` turns it into compiled code.
 """
 
@@ -33,94 +38,9 @@ from ..errors import ModelError, ParameterError
 from .expressions import checked_expr
 from .geometry import t as _TIME
 from .model import Model
+from .transitions import Explicit, Guard, Impact, Lock, Reset, Transition
 
-
-@dataclass(frozen=True)
-class Guard:
-    """Witness function of a transition.
-
-    Parameters
-    ----------
-    expr:
-        ``g(q, q̇, t)`` in the source mode's symbols.
-    direction:
-        ``-1``: fires when ``g`` goes from ``> 0`` to ``≤ 0`` (default); ``+1``: from ``< 0`` to
-        ``≥ 0``; ``0``: either way.
-    enabled:
-        Optional sympy boolean (e.g. ``foot_x > 0``) that must hold at the crossing; crossings
-        where it is false are ignored (a swing foot scuffing behind the stance foot).
-    """
-
-    expr: Any
-    direction: int = -1
-    enabled: Any = None
-
-
-class Reset:
-    """Base class of resets."""
-
-    #: name of the point whose pre-event position becomes the new origin (None: no shift)
-    shift_point: str | None = None
-
-
-@dataclass
-class Impact(Reset):
-    """Plastic impact of ``point`` with the ground, then relabelling.
-
-    The post-impact velocity solves ``M_e (q̇e⁺ − q̇e⁻) = Jᵀλ, J q̇e⁺ = 0`` for the model extended
-    with the stance-foot position (which may now lift off), ``J`` being the Jacobian of the
-    impacting point in the extended coordinates. ``relabel`` gives each coordinate of the
-    target mode as an expression of the source coordinates (e.g. ``{stance: swing,
-    swing: stance}``); velocities follow by the chain rule.
-    """
-
-    point: str
-    relabel: Mapping[Any, Any]
-
-    @property
-    def shift_point(self) -> str:  # type: ignore[override]
-        return self.point
-
-
-@dataclass
-class Lock(Reset):
-    """Impulsive constraint ``c(q) = 0`` (e.g. a knee lock ``shank − thigh``), then relabelling.
-
-    The impulse solves ``M (q̇⁺ − q̇⁻) = ∇cᵀλ, ∇c q̇⁺ = 0``; ``relabel`` gives the target
-    mode's coordinates in terms of the source coordinates.
-    """
-
-    constraint: Any
-    relabel: Mapping[Any, Any]
-
-
-@dataclass
-class Explicit(Reset):
-    """A reset written out: target coordinates and velocities as expressions of the source state.
-
-    ``q`` and ``qd`` are mappings target-name → expression, or sequences in target order (a
-    sympy Matrix such as ``J*q`` or ``H_g*q̇`` works). ``shift`` optionally names a point whose
-    pre-event position becomes the new origin (the new stance foot).
-    """
-
-    q: Any
-    qd: Any
-    shift: str | None = None
-
-    @property
-    def shift_point(self) -> str | None:  # type: ignore[override]
-        return self.shift
-
-
-@dataclass
-class Transition:
-    name: str
-    source: str
-    target: str
-    guard: Guard
-    reset: Reset | None
-    terminal: str | None = None
-    step: bool = False
+__all__ = ["Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Reset", "Transition", "target_exprs"]
 
 
 @dataclass
@@ -195,6 +115,54 @@ class HybridSystem:
             self.transitions.append(tr)
         assert tr is not None
         return tr
+
+    def add_mode(self, name: str, model: Model) -> None:
+        """Add a mode (e.g. the constrained mode of a resting contact)."""
+        if name in self.modes:
+            raise ModelError(f"system {self.name!r}: a mode named {name!r} exists already")
+        if model.dims != self.dims:
+            raise ModelError(f"system {self.name!r}: mode {name!r} mixes 2D and 3D models")
+        self.modes[name] = model
+        _ = self.parameters  # validates consistent defaults
+
+    def resting_contact(self, name: str, free: str, rest: str, gap: Any, impact: Reset, settle: Reset,
+                        force: Any, leave: Reset) -> tuple[Transition, Transition, Transition]:
+        """Declare the three transitions of a unilateral contact (usually built by
+        :func:`amble.unilateral_contact`, which derives them):
+
+        * ``name`` (``free → free``): the gap ``g(q, t)`` reaches zero falling; reset ``impact``;
+        * ``<name>_rest`` (``free → rest``): no guard; taken instead of ending the run as
+          ``zeno`` when the impacts accumulate (``Options.zeno_events`` of them closer than
+          ``Options.zeno_dt``), or at once when an impact leaves no normal velocity while the
+          flow presses into the contact (restitution 0, a point started on it); reset ``settle``;
+        * ``<name>_liftoff`` (``rest → free``): the contact force ``force`` (N, ``≥ 0`` while
+          held) falls through zero; reset ``leave``. ``force`` may be constant (it never lifts off).
+        """
+        self._check_mode(free)
+        self._check_mode(rest)
+        taken = {tr.name for tr in self.transitions}
+        names = [name, f"{name}_rest", f"{name}_liftoff"]
+        if taken & set(names):
+            dup = sorted(taken & set(names))[0]
+            raise ModelError(f"system {self.name!r}: a transition named {dup!r} exists already")
+        hit_guard, lift = Guard(gap, -1), Guard(force, -1)
+        self._check_guard(free, hit_guard)
+        rest_model = self.modes[rest]
+        if sp.sympify(force).free_symbols & (set(rest_model.q) | set(rest_model.qd)):
+            self._check_guard(rest, lift)
+        else:  # a force of the parameters and time only (a point on a fixed floor: its weight)
+            bad = sorted(str(s_) for s_ in sp.sympify(force).free_symbols - set(rest_model.params) - {_TIME})
+            if bad:
+                raise ModelError(f"system {self.name!r}: the contact force of {name!r} uses unknown symbols "
+                                 f"{', '.join(bad)}")
+        _check_reset(self.modes[free], self.modes[free], impact, names[0])
+        _check_reset(self.modes[free], rest_model, settle, names[1])
+        _check_reset(rest_model, self.modes[free], leave, names[2])
+        hit = Transition(names[0], free, free, hit_guard, impact, rest=names[1])
+        settle_tr = Transition(names[1], free, rest, Guard(sp.Integer(1)), settle, forced=True)
+        lift_tr = Transition(names[2], rest, free, lift, leave)
+        self.transitions += [hit, settle_tr, lift_tr]
+        return hit, settle_tr, lift_tr
 
     # ------------------------------------------------------------------ queries
     @property

@@ -4,13 +4,14 @@
  *   radau.h   the implicit integrator for stiff runs (IO_METHOD = 1), same dense-output contract
  *   events.h  guard screening and crossing location inside a step
  *   record.h  sample and event rows in caller-owned buffers
+ *   rest.h    a contact coming to rest instead of a zeno end (TR_REST)
  *
  * This file is included at the end of a generated translation unit, which defines:
  *   the interface codes ST_*, CX_*, OP_*, IO_* and AMBLE_LAYOUT (from amble/backend/abi.py)
  *   NMODES, NXMAX, NTR, NPOINTS, NPARAM
  *   MODE_NX[NMODES], MODE_NTR[NMODES], MODE_TR0[NMODES]
  *   TR_DIR[NTR] (-1 falling, +1 rising, 0 both), TR_TERMINAL[NTR] (1 = ends the run),
- *   TR_STEP[NTR] (1 = counts as a walking step)
+ *   TR_STEP[NTR] (1 = counts as a walking step), TR_REST[NTR] (rest transition instead of zeno, or -1)
  *   int rhs(int mode, double t, const double *x, const double *p, double *dx);
  *   void guards(int mode, double t, const double *x, const double *p, double *g);
  *   void guards_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g);
@@ -28,6 +29,7 @@
 #include "events.h"
 #include "radau.h"
 #include "record.h"
+#include "rest.h"
 #include "sensitivity.h"
 
 /* Simulate from the state in ctx until an end condition; see the CX_, OP_, IO_ layouts.
@@ -111,8 +113,9 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         /* --- how many rows this step writes; if they do not fit, return and resume here --- */
         int64_t k0 = (int64_t)ctx[CX_GRID_K], k1 = k0;
         if (recording && sample_dt > 0.0) k1 = grid_end(ctx, sample_dt, k0, t_stop);
-        int64_t need = (k1 - k0) + (ev_k >= 0 ? 2 : 0) + ((sample_dt > 0.0) ? 0 : 1);
-        if ((recording && *n_out + need > rec.out_cap) || (ev_k >= 0 && ev_recording && *n_ev + 1 > rec.ev_cap)) {
+        const int rest_room = ev_k >= 0 && ev_k < ntr && TR_REST[tr0 + ev_k] >= 0; /* room to come to rest */
+        int64_t need = (k1 - k0) + (ev_k >= 0 ? 2 : 0) + ((sample_dt > 0.0) ? 0 : 1) + rest_room;
+        if ((recording && *n_out + need > rec.out_cap) || (ev_k >= 0 && ev_recording && *n_ev + 1 + rest_room > rec.ev_cap)) {
             status = ST_BUFFER_FULL;
             break;
         }
@@ -229,6 +232,15 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
             status = ST_SLIDING;
             break;
+        }
+        /* a contact whose impacts accumulate, or that leaves the impact without normal velocity,
+         * comes to rest; sensitivities are not carried through that transition (zeno instead) */
+        if (TR_REST[tr] >= 0 && !sens
+            && ((zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) || settled(fired, s.n, s.y_old, g_old, gd_old))) {
+            if ((st = come_to_rest(tr, t, p, &s, &mode, ctx, &rec, recording, ev_recording, g_old, gd_old)) >= 0) {
+                status = st;
+                break;
+            }
         }
         if (zeno_n > 0 && ctx[CX_ZENO] >= zeno_n) { status = ST_ZENO; break; }
         if (max_steps > 0 && ctx[CX_STEPS] >= max_steps) { status = ST_STEPS_DONE; break; }
