@@ -112,7 +112,7 @@ def test_a_run_with_sensitivities_ends_as_zeno_at_the_rest_transition():
     from amble.simulation.simulate import parameter_vector
 
     s, _, _ = _ball("rc-ball")
-    k = build(s)
+    k = build(s, derivatives=True)
     p = parameter_vector(k, {"e": 0.0}, s)
     r = run(k, p, 0, np.array([0.0, 1.0, 0.0, 0.0]), t_end=3.0, opts=Options(), sensitivities=True)
     assert r.status == "zeno"
