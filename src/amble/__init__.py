@@ -19,7 +19,7 @@ from .errors import (
 )
 from .modelling.contact import RoundFoot, rolling_centre, round_foot
 from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval
-from .modelling.geometry import R3, R, t, vector
+from .modelling.geometry import R3, R, Rx, Ry, Rz, t, vector
 from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
 from .modelling.model import Model
 from .modelling.sampled import sample_and_hold
@@ -31,7 +31,8 @@ from .version import __version__  # noqa: F401  (amble.__version__)
 from .viz import animate, plot_limit_cycle, plot_trajectory
 
 __all__ = [
-    "NONNEGATIVE", "POSITIVE", "R", "R3", "AmbleError", "CompileError", "ConvergenceError", "Domain", "Equations",
+    "NONNEGATIVE", "POSITIVE", "R", "R3", "Rx", "Ry", "Rz", "AmbleError", "CompileError", "ConvergenceError",
+    "Domain", "Equations",
     "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
     "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
     "contact_force", "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",

@@ -73,7 +73,7 @@ def ldl_solve_code(n: int, a: str, b: str, indent: str = "    ") -> str:
     """C statements solving ``a x = b`` in place for a symmetric positive definite ``a`` (row-major
     n × n, lower triangle read and overwritten by the unit lower factor L; ``b`` overwritten by x),
     returning ``AMBLE_ERR_SINGULAR_MASS`` from the enclosing function if a pivot is not positive or
-    the pivots spread by more than 1e14 (the same test as ``amble_chol_solve``: cond(A) is at least
+    the pivots spread by more than 1e14 (the same test as ``amble_ldl_solve``: cond(A) is at least
     max D / min D). LDLᵀ needs no square root; up to :data:`UNROLL_MAX` the loops are unrolled so
     every index is a constant."""
     if n > UNROLL_MAX:

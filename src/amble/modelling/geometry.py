@@ -32,6 +32,24 @@ def R3(theta: sp.Expr, phi: sp.Expr) -> sp.Matrix:
     return sp.Matrix([sp.sin(theta) * sp.cos(phi), sp.sin(phi), sp.cos(theta) * sp.cos(phi)])
 
 
+def Rx(angle: sp.Expr) -> sp.Matrix:
+    """Rotation by ``angle`` (rad, right-handed) about the x axis, as a 3 × 3 matrix."""
+    c, s_ = sp.cos(angle), sp.sin(angle)
+    return sp.Matrix([[1, 0, 0], [0, c, -s_], [0, s_, c]])
+
+
+def Ry(angle: sp.Expr) -> sp.Matrix:
+    """Rotation by ``angle`` (rad, right-handed) about the y axis, as a 3 × 3 matrix."""
+    c, s_ = sp.cos(angle), sp.sin(angle)
+    return sp.Matrix([[c, 0, s_], [0, 1, 0], [-s_, 0, c]])
+
+
+def Rz(angle: sp.Expr) -> sp.Matrix:
+    """Rotation by ``angle`` (rad, right-handed) about the z axis, as a 3 × 3 matrix."""
+    c, s_ = sp.cos(angle), sp.sin(angle)
+    return sp.Matrix([[c, -s_, 0], [s_, c, 0], [0, 0, 1]])
+
+
 def vector(*components: Any) -> sp.Matrix:
     """A column vector from components (numbers or sympy expressions)."""
     if len(components) == 1 and isinstance(components[0], Iterable):

@@ -25,27 +25,15 @@ pressure inside it (not modelled).
 
 import sympy as sp
 
-from amble import NONNEGATIVE, POSITIVE, R3, Model, Walker, distance_along_slope, walker
+from amble import NONNEGATIVE, POSITIVE, R3, Model, Rx, Ry, Rz, Walker, distance_along_slope, walker
 
 NAME = "humanoid-3d-level"
 POSITION = 46  # after humanoid-3d-yaw
 
 
-def _rot_y(a):
-    return sp.Matrix([[sp.cos(a), 0, sp.sin(a)], [0, 1, 0], [-sp.sin(a), 0, sp.cos(a)]])
-
-
-def _rot_x(a):
-    return sp.Matrix([[1, 0, 0], [0, sp.cos(a), -sp.sin(a)], [0, sp.sin(a), sp.cos(a)]])
-
-
-def _rot_z(a):
-    return sp.Matrix([[sp.cos(a), -sp.sin(a), 0], [sp.sin(a), sp.cos(a), 0], [0, 0, 1]])
-
-
 def upper_body_frame(torso, torso_cor, yaw):
     """Orientation (body → world) of the upper body (pelvis + torso): columns its x, y, z axes."""
-    return _rot_y(torso) * _rot_x(-torso_cor) * _rot_z(yaw)
+    return Ry(torso) * Rx(-torso_cor) * Rz(yaw)
 
 
 def build() -> Walker:

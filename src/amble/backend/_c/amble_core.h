@@ -22,42 +22,8 @@
 #define AMBLE_ERR_SINGULAR_RESET 2
 #define AMBLE_ERR_NO_DERIVATIVES 3 /* a library built without its derivative kernels */
 
-/* Solve A x = b for symmetric positive definite A (row-major n x n, only the lower triangle is
- * read; A is overwritten by its Cholesky factor, b by x). Returns AMBLE_ERR_SINGULAR_MASS if a
- * pivot is not positive or the factor's condition estimate exceeds 1e14. */
-static int amble_chol_solve(int n, double *A, double *b) {
-    double dmin = INFINITY, dmax = 0.0;
-    for (int j = 0; j < n; ++j) {
-        double s = A[j * n + j];
-        for (int k = 0; k < j; ++k) s -= A[j * n + k] * A[j * n + k];
-        if (!(s > 0.0)) return AMBLE_ERR_SINGULAR_MASS;
-        double d = sqrt(s);
-        A[j * n + j] = d;
-        if (d < dmin) dmin = d;
-        if (d > dmax) dmax = d;
-        for (int i = j + 1; i < n; ++i) {
-            double v = A[i * n + j];
-            for (int k = 0; k < j; ++k) v -= A[i * n + k] * A[j * n + k];
-            A[i * n + j] = v / d;
-        }
-    }
-    /* cond(A) >= (dmax/dmin)^2; beyond ~1e14 the solve has no correct digits left. */
-    if (dmax > 1e7 * dmin) return AMBLE_ERR_SINGULAR_MASS;
-    for (int i = 0; i < n; ++i) {
-        double v = b[i];
-        for (int k = 0; k < i; ++k) v -= A[i * n + k] * b[k];
-        b[i] = v / A[i * n + i];
-    }
-    for (int i = n - 1; i >= 0; --i) {
-        double v = b[i];
-        for (int k = i + 1; k < n; ++k) v -= A[k * n + i] * b[k];
-        b[i] = v / A[i * n + i];
-    }
-    return 0;
-}
-
-/* The same solve by LDL^T (A = L D L^T, L unit lower triangular): no square root, and the same
- * failure test as amble_chol_solve (a pivot D_j not positive, or max D / min D > 1e14, a lower
+/* Solve A x = b for symmetric positive definite A by LDL^T (A = L D L^T, L unit lower
+ * triangular): no square root; the failure test (a pivot D_j not positive, or max D / min D > 1e14, a lower
  * bound of cond(A)). The lower triangle of A is overwritten by L, b by x. Generated right-hand
  * sides of small systems write this solve out unrolled (backend/codegen.py); larger ones call it. */
 static int amble_ldl_solve(int n, double *A, double *b) {
@@ -159,7 +125,8 @@ static int amble_impulse(int ne, int nc, const double *Me, const double *J, doub
 /* ---- solves for sensitivity runs: one factorisation, many right-hand sides ---- */
 
 /* Cholesky factor of a symmetric positive definite A (row-major, lower triangle read and
- * overwritten by L). Same acceptance test as amble_chol_solve. */
+ * overwritten by L). A pivot not positive, or pivots spread by more than 1e7 (cond(A) ≥ 1e14),
+ * is AMBLE_ERR_SINGULAR_MASS, as for amble_ldl_solve. */
 static int amble_chol_factor(int n, double *A) {
     double dmin = INFINITY, dmax = 0.0;
     for (int j = 0; j < n; ++j) {
