@@ -61,7 +61,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     if args.clearance is not None and not args.clearance >= 0:
         raise UsageError(f"--clearance must be ≥ 0, got {args.clearance:g}")
     nodes = parse_nodes(args.nodes)
-    if not 1 <= args.bezier_degree <= 20:
+    if args.bezier_degree is not None and not 1 <= args.bezier_degree <= 20:
         raise UsageError(f"--bezier-degree must be in [1, 20], got {args.bezier_degree}")
     if args.max_iter < 1:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
@@ -119,8 +119,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--hzd", action="store_true",
                    help="make the gait satisfy Bézier virtual constraints (their α are optimised too), so "
                         "that an HZD controller with the exported α reproduces it")
-    o.add_argument("--bezier-degree", type=int, default=5, dest="bezier_degree",
-                   help="degree of the Bézier virtual constraints (default 5)")
+    o.add_argument("--bezier-degree", type=int, default=None, dest="bezier_degree",
+                   help="degree of the Bézier virtual constraints (default: the model's own, else 5)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")
