@@ -68,6 +68,7 @@ def optimize_gait(
     nodes: int | Sequence[int] = 30,
     guess: str | Sequence[float] | None = None,
     step_time: float | None = None,
+    posture: Sequence[float] | None = None,
     mu: float | None = None,
     clearance: float | None = None,
     bounds: Mapping[str, tuple[float | None, float | None]] | None = None,
@@ -89,6 +90,8 @@ def optimize_gait(
     works), ``"passive"`` (the default: a passive step on the system's own gait), ``"stand"``
     (standing still in the posture of the system's guess for ``step_time``) or ``"interpolate"``
     (from that posture to the relabelled one); see :func:`~amble.analysis.gait_start.initial_guess`.
+    ``posture``: the coordinates (rad, m) of a ``"stand"`` or ``"interpolate"`` start instead of
+    the system's guess (e.g. a stride held still in double support).
     ``bounds``: ``{state name: (low, high)}`` limits on coordinates or velocities at every point.
     ``bezier_degree``, ``phase``: the Bézier virtual constraints reported with the gait (the phase
     an expression of the coordinates). For a model that declares virtual constraints
@@ -131,7 +134,7 @@ def optimize_gait(
     P = np.array([pvals[k] for k in fns.param_names])
 
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
-    x_guess, t_guess = initial_guess(system, fns, pvals, guess, levels[0], step_time)
+    x_guess, t_guess = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture)
     warm: Gait | None = None
     total_iter, total_time = 0, 0.0
 

@@ -69,8 +69,15 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     guess = _guess(args.guess)
     s = load_model(args.model)
     params = parse_sets(args.set)
+    posture = None
+    if args.posture is not None:
+        vals = args.posture.split(",")
+        if any(not v.strip() for v in vals):
+            raise UsageError(f"--posture: empty value in {args.posture!r}")
+        posture = [_float(v, "--posture") for v in vals]
     gait = optimize_gait(s, params=params, speed=args.speed, step_length=args.step_length, objective=args.objective,
-                         nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time, mu=args.mu,
+                         nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time,
+                         posture=posture, mu=args.mu,
                          clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, hzd=args.hzd,
                          bezier_degree=args.bezier_degree, progress=not args.quiet)
     out = gait.to_json()
@@ -112,6 +119,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
                                    "walked one step)")
     o.add_argument("--step-time", type=float, dest="step_time",
                    help="step time in s of a 'stand' or 'interpolate' guess (default 0.5)")
+    o.add_argument("--posture", metavar="Q1,Q2,...",
+                   help="coordinates of a 'stand' or 'interpolate' guess (default: the model's guess)")
     o.add_argument("--mu", type=float, help="friction coefficient at the stance foot (default: no cone)")
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",
