@@ -332,4 +332,14 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
                    "phase_start": str(vc.phase_start), "phase_end": str(vc.phase_end), "degree": vc.degree}
     return StepFunctions(n, nu, d, m.state_names, [str(s) for s in inputs], pnames, weight, dynamics, contact,
                          impact, relabel, guard, enabled, distance, normal, rates, input_matrix, phase_fn,
-                         sp.sstr(phase), f_int, outputs, [sp.sstr(e) for e in out_expr], virtual)
+                         sp.sstr(phase), f_int, outputs, _output_texts(vc, B, m.q), virtual)
+
+
+def _output_texts(vc: Any, B: sp.Matrix, q: list) -> list[str]:
+    """The outputs as text: the model's declared ones, else ``B_jᵀ q`` with numeric coefficients
+    written as floats (``-1.0*stance + 1.0*swing``: parsed back by ``sympify``)."""
+    if vc is not None:
+        return [sp.sstr(e) for e in vc.outputs]
+    coef = lambda b: sp.Float(b, 12) if b.is_number else b
+    return [sp.sstr(sum((coef(B[i, j]) * q[i] for i in range(B.rows) if B[i, j] != 0), sp.Integer(0)))
+            for j in range(B.cols)]
