@@ -47,6 +47,7 @@ def test_rabbit_hzd_gait_at_0_8_m_per_s_satisfies_the_models_virtual_constraints
     assert g.speed == pytest.approx(SPEED, rel=1e-9)
     assert g.constraints["contact"]["max_violation"] <= 1e-8
     assert np.abs(g.inputs).max() <= 150.0 + 1e-8
+    assert np.abs(g.states[:, g.state_names.index("torso")]).max() < 0.5  # upright, not a hanging torso
     bz = g.bezier
     assert bz["phase"]["expression"] == str(s.modes["rabbit"].virtual.phase)
     assert len(bz["params"]) == 4 * 6 + 2
