@@ -16,7 +16,7 @@ export, building the NLP and the solve:
   alone; loading the URDF and building the walker (about 5 s) is reported beside it;
 * the library model ``rabbit`` (Westervelt et al.'s parameters, four joint torques ≤ 150 N·m)
   with ``hzd=True`` in its own virtual constraints (outputs, phase, degree 5), 0.8 m/s, 20
-  intervals, from the interpolated start (see ``RABBIT_CASES`` on standing still); the time
+  intervals and refined 20 → 80, from the interpolated start (see ``RABBIT_CASES`` on standing still); the time
   includes deriving the model (about 3 s) and the export.
   Its last column is Newton on the model's compiled HZD closed loop with the exported parameters.
 
@@ -133,13 +133,16 @@ def run(quick: bool = False) -> Section:
 #: swings below the hip (torso ≈ −3.5 rad), and with the torso bounded to ±0.5 rad it is
 #: locally infeasible — so the benchmark starts from the interpolated step.
 RABBIT_CASES: list[tuple[str, dict[str, Any]]] = [
-    ("interpolated start (posture to its relabelling)", {"guess": "interpolate", "step_time": 0.4}),
+    ("interpolated start (posture to its relabelling), N = 20",
+     {"guess": "interpolate", "step_time": 0.4, "nodes": 20}),
+    ("interpolated start, N = 20 → 80 (the closed loop within 1e-4 of it)",
+     {"guess": "interpolate", "step_time": 0.4, "nodes": [20, 80]}),
 ]
 
 
 def _rabbit_library(reps: int) -> tuple[list[list[str]], list[Goal], dict[str, Any]]:
-    """The library model ``rabbit`` (its own virtual constraints, HZD), 0.8 m/s, N = 20, from the
-    starts of ``RABBIT_CASES``; the fixed point checked by Newton on the model's
+    """The library model ``rabbit`` (its own virtual constraints, HZD), 0.8 m/s, the cases of
+    ``RABBIT_CASES``; the fixed point checked by Newton on the model's
     compiled closed loop with the exported parameters."""
     import time
 
@@ -150,26 +153,27 @@ def _rabbit_library(reps: int) -> tuple[list[list[str]], list[Goal], dict[str, A
     from amble.models import rabbit
 
     rows, goals, data = [], [], {}
-    for label, kw in RABBIT_CASES:
+    for i, (label, kw) in enumerate(RABBIT_CASES):
         walls, gait = [], None
         for _ in range(reps):
             s = rabbit.build()  # afresh: the time includes the derivation and the CasADi export
             t0 = time.perf_counter()
-            gait = optimize_gait(s, speed=0.8, nodes=20, hzd=True, **kw)
+            gait = optimize_gait(s, speed=0.8, hzd=True, **kw)
             walls.append(time.perf_counter() - t0)
         st = Stats.of(walls)
         lc = find_fixed_point(rabbit.build(), gait.fixed_point, params=gait.bezier["params"])
         err = float(np.abs(lc.fixed_point - gait.fixed_point).max())
         sv = gait.solver
         its, ipopt = sv["iterations_total"], sv["time_total_s"]
-        name = f"`rabbit` (library, HZD), 0.8 m/s, {label}, N = 20"
+        name = f"`rabbit` (library, HZD), 0.8 m/s, {label}"
         rows.append([name, sec(st.median, 2), sec(st.min, 2), str(its), sec(ipopt, 2), sci(gait.max_violation),
                      f"{gait.objective:.4g}", sci(err)])
         data[name] = {"walls": walls, "iterations": its, "ipopt_s": ipopt, "fixed_point_error": err,
                       "objective": gait.objective, "newton_residual": float(lc.residual)}
-        goals.append(Goal(f"gait optimisation, library RABBIT one step at 0.8 m/s with HZD, {label}",
-                          f"≤ {GOAL_RABBIT_S:g} s", f"{st.median:.2f} s (min {st.min:.2f}), {its} iterations",
-                          st.median <= GOAL_RABBIT_S))
+        if i == 0:  # the issue's goal: the one-step gait; the refined mesh is reported beside it
+            goals.append(Goal(f"gait optimisation, library RABBIT one step at 0.8 m/s with HZD, {label}",
+                              f"≤ {GOAL_RABBIT_S:g} s", f"{st.median:.2f} s (min {st.min:.2f}), {its} iterations",
+                              st.median <= GOAL_RABBIT_S))
     return rows, goals, data
 
 
