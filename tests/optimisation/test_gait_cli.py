@@ -71,3 +71,21 @@ def test_solver_failure_names_the_reason_exit_1(capsys, tmp_path):
     assert code == 1
     assert "iteration limit" in err and "most violated" in err and "Traceback" not in err
     assert json.loads(out)["type"] == "SolverError"
+
+
+def test_posture_has_the_models_coordinate_count(capsys, tmp_path):
+    code, _, err = run(capsys, "optimize-gait", "rabbit", "--guess", "stand", "--posture", "0,1",
+                       "--out", str(tmp_path / "g.json"))
+    assert code == 2 and "posture must be 5 finite numbers" in err and "Traceback" not in err
+
+
+@pytest.mark.slow
+def test_rabbit_at_0_8_m_per_s_from_the_command_line(capfd, tmp_path):
+    """The issue's command on the library RABBIT (default start: a step of its HZD controller,
+    which compiles once): 0.8 m/s, feasible, the parameters for its controller in gait.json."""
+    path = tmp_path / "gait.json"
+    code, out, err = run(capfd, "optimize-gait", "rabbit", "--speed", "0.8", "--hzd", "--out", str(path), "--quiet")
+    assert code == 0, err
+    d = json.loads(path.read_text())
+    assert d["speed"] == pytest.approx(0.8, rel=1e-9) and d["max_violation"] <= 1e-8
+    assert set(d["bezier"]["params"]) >= {"alpha_0_0", "alpha_3_5", "phase_start", "phase_end"}

@@ -1,6 +1,7 @@
 """RABBIT's proportions (``tests/data/rabbit.urdf``, a 5-link planar biped with a pivoting point
-foot and four actuated joints): a 0.8 m/s gait from standing still, feasible to 1e-8. (No
-``rabbit`` model in the library yet; this is the URDF guide's walker with actuators added.)"""
+foot and four actuated joints): a 0.8 m/s gait from standing still, feasible to 1e-8. (The URDF
+guide's walker with actuators added; the library model ``rabbit`` under its HZD controller is
+tested in ``test_gait_rabbit_hzd.py``.)"""
 
 from pathlib import Path
 

@@ -1,6 +1,7 @@
 """Virtual constraints inside a gait optimisation (the HZD formulation of FROST).
 
-With ``hzd=True`` each actuated quantity ``Bᵀq`` must follow a Bézier polynomial in the phase
+With ``hzd=True`` each output ``h₀(q)`` — the model's declared virtual-constraint outputs, else
+the actuated quantities ``Bᵀq`` (:attr:`StepFunctions.outputs`) — must follow a Bézier polynomial in the phase
 ``s = (θ − θ⁺)/(θ⁻ − θ⁺)`` (:mod:`amble.modelling.virtual`), the coefficients ``α`` being unknowns
 of the problem: the gait then lies on the zero-dynamics surface, and the HZD controller with the
 optimised ``α`` reproduces it. Outputs and their rates are constrained at the mesh points.
@@ -27,7 +28,7 @@ def _input_map(fns: StepFunctions, x: np.ndarray, P: np.ndarray) -> np.ndarray:
 
 
 def virtual_constraints(fns: StepFunctions, X: Any, P: np.ndarray, x_guess: np.ndarray, alpha: Any) -> Any:
-    """The outputs ``y = Bᵀq − h_d(s, α)`` and their rates ``ẏ`` at the mesh points (``X`` holds
+    """The outputs ``y = h₀(q) − h_d(s, α)`` and their rates ``ẏ`` at the mesh points (``X`` holds
     all ``2N + 1`` points), ``s = (θ − θ⁺)/(θ⁻ − θ⁺)`` with ``θ⁺``, ``θ⁻`` the phase at the first
     and the last point. The midpoints are left free: there ``y = 0`` would fix the inputs a
     second time and make them ring between the points; ``ẏ = 0`` puts the post-impact state on
@@ -36,12 +37,13 @@ def virtual_constraints(fns: StepFunctions, X: Any, P: np.ndarray, x_guess: np.n
     if fns.nu == 0:
         raise ParameterError("virtual constraints need inputs: the model declares no actuators")
     n, nu, degree = fns.n, fns.nu, alpha.shape[1] - 1
-    B = ca.DM(_input_map(fns, x_guess, P))
+    if fns.virtual is None:
+        _input_map(fns, x_guess, P)  # the outputs Bᵀq need a constant B
     q, v, a = ca.SX.sym("q", n), ca.SX.sym("v", n), ca.SX.sym("alpha", nu, degree + 1)
     t0, t1 = ca.SX.sym("t0"), ca.SX.sym("t1")
     s = (fns.phase(q, P) - t0) / (t1 - t0)
     basis = ca.vertcat(*[comb(degree, k) * s**k * (1 - s) ** (degree - k) for k in range(degree + 1)])
-    y = ca.mtimes(B.T, q) - ca.mtimes(a, basis)
+    y = fns.outputs(q, P) - ca.mtimes(a, basis)
     yf = ca.Function("y", [q, v, a, t0, t1], [y, ca.jtimes(y, q, v)])
     K = X.shape[1]
     th0, th1 = fns.phase(X[:n, 0], P), fns.phase(X[:n, -1], P)
@@ -52,9 +54,9 @@ def virtual_constraints(fns: StepFunctions, X: Any, P: np.ndarray, x_guess: np.n
 
 def bezier_start(fns: StepFunctions, x: np.ndarray, P: np.ndarray, degree: int) -> np.ndarray:
     """Least-squares Bézier coefficients (nu × (M+1)) of the guessed trajectory."""
-    B = _input_map(fns, x, P)
     theta = np.array([float(fns.phase(xi[: fns.n], P)) for xi in x])
     span = theta[-1] - theta[0]
     s = (theta - theta[0]) / span if abs(span) > 1e-12 else np.linspace(0.0, 1.0, len(x))
-    alpha, *_ = np.linalg.lstsq(bernstein(s, degree), x[:, : fns.n] @ B, rcond=None)
+    Y = np.array([np.asarray(fns.outputs(xi[: fns.n], P), float).ravel() for xi in x])
+    alpha, *_ = np.linalg.lstsq(bernstein(s, degree), Y, rcond=None)
     return alpha.T

@@ -168,29 +168,40 @@ def bernstein(s: np.ndarray, degree: int) -> np.ndarray:
     return c * s**k * (1 - s) ** (degree - k)
 
 
-def bezier_fit(model: Any, fns: StepFunctions, X: np.ndarray, degree: int, P: np.ndarray) -> dict[str, Any] | None:
-    """HZD virtual constraints of the gait: each actuated quantity ``y_j = B_jᵀ q`` as a Bézier
-    polynomial of degree ``degree`` in the phase ``s = (θ − θ⁺)/(θ⁻ − θ⁺)``, fitted by least
-    squares over the collocation points; ``θ(q)`` is :attr:`StepFunctions.phase` (``θ⁺``, ``θ⁻``
-    its values after and before the impact). Needs a constant ``B`` (actuated quantities linear
-    in ``q``) and ``θ`` strictly increasing over the step; otherwise None."""
+def bezier_fit(model: Any, fns: StepFunctions, X: np.ndarray, degree: int, P: np.ndarray,
+               alpha: np.ndarray | None = None) -> dict[str, Any] | None:
+    """HZD virtual constraints of the gait: each output ``h₀(q)`` (:attr:`StepFunctions.outputs`:
+    the model's declared outputs, else the actuated quantities ``Bᵀq``) as a Bézier polynomial of
+    degree ``degree`` in the phase ``s = (θ − θ⁺)/(θ⁻ − θ⁺)``, fitted by least squares over the
+    collocation points unless ``alpha`` (nu × (M+1), the optimised coefficients of an HZD gait)
+    is given; ``θ(q)`` is :attr:`StepFunctions.phase` (``θ⁺``, ``θ⁻`` its values after and before
+    the impact). For a model with virtual constraints of that degree, ``params`` holds the values
+    of its ``alpha``, ``phase_start`` and ``phase_end`` parameters (``simulate(..., params=...)``
+    then runs its controller on this gait). Without the model's outputs it needs a constant ``B``
+    (actuated quantities linear in ``q``); ``θ`` must increase strictly over the step; otherwise None."""
     if fns.nu == 0 or degree < 1:
         return None
     n = fns.n
     Q = X[:, :n]
-    Bs = [np.asarray(fns.input_matrix(q, P), float).reshape(n, fns.nu) for q in Q]
-    B = Bs[0]
-    if any(np.abs(b - B).max() > 1e-12 * max(np.abs(B).max(), 1.0) for b in Bs):
-        return None  # actuated quantities not linear in q: no single output map to report
+    if fns.virtual is None:
+        Bs = [np.asarray(fns.input_matrix(q, P), float).reshape(n, fns.nu) for q in Q]
+        if any(np.abs(b - Bs[0]).max() > 1e-12 * max(np.abs(Bs[0]).max(), 1.0) for b in Bs):
+            return None  # actuated quantities not linear in q: no single output map to report
     theta = np.array([float(fns.phase(q, P)) for q in Q])
     if np.any(np.diff(theta) <= 0):
         return None
     s = (theta - theta[0]) / (theta[-1] - theta[0])
-    Y = Q @ B
+    Y = np.array([np.asarray(fns.outputs(q, P), float).ravel() for q in Q])
     basis = bernstein(s, degree)
-    alpha, *_ = np.linalg.lstsq(basis, Y, rcond=None)
-    outputs = [sp.sstr(sum((sp.Float(B[i, j], 12) * model.q[i] for i in range(n) if B[i, j] != 0), sp.Integer(0)))
-               for j in range(fns.nu)]
-    return {"degree": degree, "outputs": outputs, "inputs": list(fns.input_names),
-            "phase": {"expression": fns.phase_text, "theta_plus": float(theta[0]), "theta_minus": float(theta[-1])},
-            "alpha": alpha.T.tolist(), "fit_error": float(np.abs(basis @ alpha - Y).max())}
+    if alpha is None:
+        alpha = np.linalg.lstsq(basis, Y, rcond=None)[0].T
+    alpha = np.asarray(alpha, float).reshape(fns.nu, degree + 1)
+    out = {"degree": degree, "outputs": list(fns.output_texts or []), "inputs": list(fns.input_names),
+           "phase": {"expression": fns.phase_text, "theta_plus": float(theta[0]), "theta_minus": float(theta[-1])},
+           "alpha": alpha.tolist(), "fit_error": float(np.abs(basis @ alpha.T - Y).max())}
+    vc = fns.virtual
+    if vc is not None and vc["degree"] == degree and len(vc["alpha"]) == fns.nu:
+        values = {name: float(alpha[i, k]) for i, row in enumerate(vc["alpha"]) for k, name in enumerate(row)}
+        values[vc["phase_start"]], values[vc["phase_end"]] = float(theta[0]), float(theta[-1])
+        out["params"] = values
+    return out

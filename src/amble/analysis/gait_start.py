@@ -21,7 +21,7 @@ SETTLE_STEPS = 30
 
 
 def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, float], guess: Any, N: int,
-                  step_time: float | None) -> tuple[np.ndarray, float]:
+                  step_time: float | None, posture: Any = None) -> tuple[np.ndarray, float]:
     """States at the ``2N + 1`` collocation points and the step time (s) to start from.
 
     ``guess`` ``None``/``"passive"``: the passive walk from the system's fixed-point guess (or
@@ -30,7 +30,8 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
     ``"stand"``: the posture of the system's guess (or of the given state), held still with zero
     velocities; ``"interpolate"``: from that posture to its relabelled one at constant rates. A
     passive step that does not end in a footfall falls back to ``"interpolate"``. ``step_time``
-    (s) is the duration of the last two.
+    (s) is the duration of the last two; ``posture`` (the ``n`` coordinates, rad or m) replaces the
+    guess's posture in them.
     """
     K, n = 2 * N + 1, fns.n
     if isinstance(guess, str) and guess not in GUESSES:
@@ -60,6 +61,13 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
             tau = np.linspace(0.0, t[-1], K)
             return np.column_stack([np.interp(tau, t, x[:, i]) for i in range(2 * n)]), float(t[-1])
     q0 = x0[:n]
+    if posture is not None:
+        if kind not in ("stand", "interpolate"):
+            raise ParameterError("a posture is the start of guess='stand' or 'interpolate' only")
+        q0 = np.asarray(posture, float)
+        if q0.shape != (n,) or not np.all(np.isfinite(q0)):
+            raise StateError(f"posture must be {n} finite numbers ({', '.join(fns.state_names[:n])}), "
+                             f"got {np.asarray(posture).tolist()}")
     if kind == "stand":
         return np.tile(np.concatenate([q0, np.zeros(n)]), (K, 1)), T
     # the relabelling of a footfall swaps legs, so (as an involution) it maps the first posture to the last

@@ -184,7 +184,8 @@ class StepFunctions:
     * ``normal(p)``: the slope's unit normal; ``actuator_rates(q, qd, p)``: ``Bᵀ q̇`` (rad/s or m/s);
     * ``input_matrix(q, p)``: ``B`` (``n × nu``); ``phase(q, p)``: the phase variable ``θ`` of the
       gait's virtual constraints;
-    * ``weight(p)``: ``mₜ |g|`` (N), the scale of the cost of transport.
+    * ``weight(p)``: ``mₜ |g|`` (N), the scale of the cost of transport;
+    * ``outputs(q, p)``: the quantities held by a gait's virtual constraints (see the field).
     """
 
     n: int
@@ -207,6 +208,14 @@ class StepFunctions:
     phase: Any
     phase_text: str
     integrand: Any = None
+    #: ``outputs(q, p)``: the quantities the virtual constraints of a gait hold on Bézier
+    #: polynomials — the model's declared outputs ``h₀(q)`` when it has virtual constraints
+    #: (:meth:`Model.virtual_constraints`), else the actuated quantities ``Bᵀq``; with their texts
+    outputs: Any = None
+    output_texts: list[str] | None = None
+    #: the names of the model's virtual-constraint parameters: ``alpha`` (rows of Bézier
+    #: coefficient names), ``phase_start``, ``phase_end``, ``degree`` (None without them)
+    virtual: dict[str, Any] | None = None
 
 
 def _conditions(cond: Any) -> list[sp.Expr]:
@@ -300,6 +309,9 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     distance = ca.Function("distance", [q, p], [T(dist)], ["q", "p"], ["distance"])
     normal = ca.Function("normal", [p], [T.matrix(nvec)], ["p"], ["n"])
     rates = ca.Function("actuator_rates", [q, qd, p], [T.matrix(B.T * sp.Matrix(m.qd)) if nu else ca.SX(0, 1)])
+    vc = getattr(m, "virtual", None)
+    if phase is None and vc is not None:  # the phase of the model's own controller
+        phase = vc.phase
     if phase is None:
         hip = getattr(system, "hip", None)
         point = m.points[hip] if hip is not None else foot
@@ -310,6 +322,24 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
         f_int = ca.Function("integrand", [q, qd, u, tt, p], [T(integrand)])
     input_matrix = ca.Function("input_matrix", [q, p], [T.matrix(B) if nu else ca.SX(n, 0)], ["q", "p"], ["B"])
     weight = ca.Function("weight", [p], [T(mt) * ca.norm_2(T.matrix(m.gravity_vector))], ["p"], ["weight"])
+    # the controller's outputs when the model declares virtual constraints: the collocation then
+    # holds the very quantities, phase and polynomial that the compiled HZD controller drives
+    out_expr = list(vc.outputs) if vc is not None else list(B.T * sp.Matrix(m.q)) if nu else []
+    outputs = ca.Function("outputs", [q, p], [T.matrix(out_expr) if out_expr else ca.SX(0, 1)], ["q", "p"], ["h0"])
+    virtual = None
+    if vc is not None:
+        virtual = {"alpha": [[str(vc.alpha[i, k]) for k in range(vc.alpha.cols)] for i in range(vc.alpha.rows)],
+                   "phase_start": str(vc.phase_start), "phase_end": str(vc.phase_end), "degree": vc.degree}
     return StepFunctions(n, nu, d, m.state_names, [str(s) for s in inputs], pnames, weight, dynamics, contact,
                          impact, relabel, guard, enabled, distance, normal, rates, input_matrix, phase_fn,
-                         sp.sstr(phase), f_int)
+                         sp.sstr(phase), f_int, outputs, _output_texts(vc, B, m.q), virtual)
+
+
+def _output_texts(vc: Any, B: sp.Matrix, q: list) -> list[str]:
+    """The outputs as text: the model's declared ones, else ``B_jᵀ q`` with numeric coefficients
+    written as floats (``-1.0*stance + 1.0*swing``: parsed back by ``sympify``)."""
+    if vc is not None:
+        return [sp.sstr(e) for e in vc.outputs]
+    coef = lambda b: sp.Float(b, 12) if b.is_number else b
+    return [sp.sstr(sum((coef(B[i, j]) * q[i] for i in range(B.rows) if B[i, j] != 0), sp.Integer(0)))
+            for j in range(B.cols)]

@@ -62,7 +62,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     if args.clearance is not None and not args.clearance >= 0:
         raise UsageError(f"--clearance must be ≥ 0, got {args.clearance:g}")
     nodes = parse_nodes(args.nodes)
-    if not 1 <= args.bezier_degree <= 20:
+    if args.bezier_degree is not None and not 1 <= args.bezier_degree <= 20:
         raise UsageError(f"--bezier-degree must be in [1, 20], got {args.bezier_degree}")
     if args.max_iter < 1:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
@@ -70,8 +70,15 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     guess = _guess(args.guess)
     s = load_model(args.model)
     params = parse_sets(args.set)
+    posture = None
+    if args.posture is not None:
+        vals = args.posture.split(",")
+        if any(not v.strip() for v in vals):
+            raise UsageError(f"--posture: empty value in {args.posture!r}")
+        posture = [_float(v, "--posture") for v in vals]
     gait = optimize_gait(s, params=params, speed=args.speed, step_length=args.step_length, objective=args.objective,
-                         nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time, mu=args.mu,
+                         nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time,
+                         posture=posture, mu=args.mu,
                          clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, hzd=args.hzd,
                          bezier_degree=args.bezier_degree, progress=not args.quiet)
     out = gait.to_json()
@@ -113,6 +120,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
                                    "walked one step)")
     o.add_argument("--step-time", type=float, dest="step_time",
                    help="step time in s of a 'stand' or 'interpolate' guess (default 0.5)")
+    o.add_argument("--posture", metavar="Q1,Q2,...",
+                   help="coordinates of a 'stand' or 'interpolate' guess (default: the model's guess)")
     o.add_argument("--mu", type=float, help="friction coefficient at the stance foot (default: no cone)")
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",
@@ -120,8 +129,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--hzd", action="store_true",
                    help="make the gait satisfy Bézier virtual constraints (their α are optimised too), so "
                         "that an HZD controller with the exported α reproduces it")
-    o.add_argument("--bezier-degree", type=int, default=5, dest="bezier_degree",
-                   help="degree of the Bézier virtual constraints (default 5)")
+    o.add_argument("--bezier-degree", type=int, default=None, dest="bezier_degree",
+                   help="degree of the Bézier virtual constraints (default: the model's own, else 5)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")
