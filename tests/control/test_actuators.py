@@ -8,18 +8,13 @@ import pytest
 import sympy as sp
 
 from amble import HybridSystem, Model, ModelError, R, derive, simulate, walker
+from amble.models.compass_gait import model as compass_model
 
 
 def _compass(law=None, limit=40.0):
-    m = Model("cg-actuated")
-    st, sw = m.coordinates("stance swing")
-    mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
-    m.point("stance_foot", (0, 0))
-    hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
-    m.point("stance_mass", b * R(st), mass=ml)
-    m.point("swing_mass", hip - a * R(sw), mass=ml)
-    m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
-    m.gravity(g)
+    m = compass_model("cg-actuated")
+    st, sw = m.q
+    slope = m.symbol("slope")
     u = m.actuator("hip_torque", on=sw - st, limit=limit)
     if law is not None:
         m.control({u: law(m, st, sw)})

@@ -7,22 +7,17 @@ import pytest
 import sympy as sp
 from scipy.integrate import solve_ivp
 
-from amble import Model, ModelError, R, derive, simulate, walker
+from amble import Model, ModelError, derive, simulate, walker
 from amble.analysis.hzd import hybrid_invariance_error, impact_on_zero_dynamics, invariant_parameters, restricted_map
 from amble.analysis.poincare import find_fixed_point
 from amble.derivation.hzd import zero_dynamics
+from amble.models.compass_gait import model as compass_model
 
 
 def _compass_hzd():
-    m = Model("cg-hzd")
-    st, sw = m.coordinates("stance swing")
-    mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
-    m.point("stance_foot", (0, 0))
-    hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
-    m.point("stance_mass", b * R(st), mass=ml)
-    m.point("swing_mass", hip - a * R(sw), mass=ml)
-    m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
-    m.gravity(g)
+    m = compass_model("cg-hzd")
+    st, sw = m.q
+    slope = m.symbol("slope")
     m.actuator("hip_torque", on=sw - st)
     m.virtual_constraints([sw], st, [[0.3168, 0.1, -0.1, -0.2168]], (-0.2168, 0.3168), epsilon=0.05)
     return m, walker(m, foot="swing_foot", hip="hip", slope=slope, relabel={st: sw, sw: st},

@@ -6,6 +6,7 @@ from scipy.integrate import solve_ivp
 
 from amble import HybridSystem, Model, ModelError, R, simulate
 from amble.modelling.sampled import sample_and_hold
+from amble.models.compass_gait import model as compass_model
 
 
 def _pendulum():
@@ -59,15 +60,9 @@ def test_a_walker_sampled_at_1khz_walks_like_the_continuous_one():
     continuous law's by O(1/rate)."""
     from amble import walker
 
-    m = Model("compass-pd")
-    st, sw = m.coordinates("stance swing")
-    mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
-    m.point("stance_foot", (0, 0))
-    hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
-    m.point("stance_mass", b * R(st), mass=ml)
-    m.point("swing_mass", hip - a * R(sw), mass=ml)
-    m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
-    m.gravity(g)
+    m = compass_model("compass-pd")
+    st, sw = m.q
+    slope = m.symbol("slope")
     u = m.actuator("hip_torque", on=sw - st)
     m.control({u: -5 * (sw + st) - (m.dot(sw) + m.dot(st))})
     pd = walker(m, foot="swing_foot", hip="hip", slope=slope, relabel={st: sw, sw: st},

@@ -20,10 +20,13 @@ NAME = "compass-gait"
 POSITION = 10  # place in `amble models` (ascending)
 
 
-def build():
-    m = Model("compass-gait")
+def model(name: str = "compass-gait", slope: float = 0.05) -> Model:
+    """The compass gait's mechanics (coordinates ``stance, swing``, Table 2's parameters, the
+    ``slope`` parameter's default as given), before its walker is declared: actuated and controlled
+    variants add inputs and laws to it."""
+    m = Model(name)
     st, sw = m.coordinates("stance swing")
-    mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.05)
+    mh, ml, a, b, g, _ = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=slope)
     m.restrict("mh m a b g", POSITIVE)
     m.point("stance_foot", (0, 0))
     hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
@@ -31,5 +34,11 @@ def build():
     m.point("swing_mass", hip - a * R(sw), mass=ml)
     m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
     m.gravity(g)
-    return walker(m, foot="swing_foot", hip="hip", slope=slope, relabel={st: sw, sw: st},
+    return m
+
+
+def build():
+    m = model()
+    st, sw = m.q
+    return walker(m, foot="swing_foot", hip="hip", slope=m.symbol("slope"), relabel={st: sw, sw: st},
                   start=[-0.2168, 0.3168, 1.0839, 0.3981], doc=__doc__)

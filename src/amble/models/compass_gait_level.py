@@ -21,24 +21,18 @@ model's slope); ``slope`` stays a parameter (the closed loop on a slope ``s`` wa
 
 import sympy as sp
 
-from amble import POSITIVE, Model, R, walker
+from amble import walker
+from amble.models import compass_gait
 
 NAME = "compass-gait-level"
 POSITION = 45  # after the thesis models
 
 
 def build():
-    m = Model("compass-gait-level")
-    st, sw = m.coordinates("stance swing")
-    mh, ml, a, b, g, slope = m.parameters(mh=10.0, m=5.0, a=0.5, b=0.5, g=9.81, slope=0.0)
+    m = compass_gait.model("compass-gait-level", slope=0.0)
+    st, sw = m.q
+    slope = m.symbol("slope")
     gamma = m.parameter("emulated_slope", 0.05, "slope whose passive gait the controller reproduces", "rad")
-    m.restrict("mh m a b g", POSITIVE)
-    m.point("stance_foot", (0, 0))
-    hip = m.point("hip", (a + b) * R(st), mass=mh, link="stance_foot")
-    m.point("stance_mass", b * R(st), mass=ml)
-    m.point("swing_mass", hip - a * R(sw), mass=ml)
-    m.point("swing_foot", hip - (a + b) * R(sw), link="hip")
-    m.gravity(g)
     u_hip = m.actuator("hip", on=sw - st)
     u_ankle = m.actuator("ankle", on=st)
     V = m.V
