@@ -119,10 +119,20 @@ def test_time_dependent_guard_and_reset():
     assert r.events >= 3
 
 
-def test_terminal_event_time():
-    from tests.events.systems import guarded_pendulum
+def _guarded_pendulum() -> HybridSystem:
+    """A pendulum whose terminal guard ``A − θ`` fires when θ exceeds the parameter A."""
+    m = Model("sens-terminal")
+    (th,) = m.coordinates(["theta"])
+    g, a = m.parameters(g=9.81, A=0.5)
+    m.point("bob", sp.Matrix([sp.sin(th), -sp.cos(th)]), mass=1.0)
+    m.gravity(g)
+    s = HybridSystem("sens-terminal", m)
+    s.terminal("past_A", "sens-terminal", Guard(a - th, -1), status="past_A")
+    return s
 
-    r = _check(guarded_pendulum("sens-terminal"), [0.0, 2.0])
+
+def test_terminal_event_time():
+    r = _check(_guarded_pendulum(), [0.0, 2.0])
     assert r.status == "past_A"
     # the end state lies on the guard θ = A for every perturbation: its θ row is the A column
     assert r.sensitivity.dx_dx0[0] == pytest.approx([0.0, 0.0], abs=1e-12)
