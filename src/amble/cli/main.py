@@ -51,10 +51,11 @@ def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
         rows.append({"name": name, "dims": s.dims, "modes": s.mode_names, "state_names": s.state_names(first),
                      "parameters": s.parameters, "summary": _plain(s.doc)})
     if not args.json:
+        width = max((len(r["name"]) for r in rows), default=0)  # the longest name sets the column
         for r in rows:
             n = len(r["state_names"]) // 2
             count = f"{n} coordinate{'' if n == 1 else 's'}"
-            print(f"{r['name']:<16} {r['dims']}D  {count:<14} {r['summary']}")
+            print(f"{r['name']:<{width}}  {r['dims']}D  {count:<14} {r['summary']}")
     return {"models": rows}
 
 
