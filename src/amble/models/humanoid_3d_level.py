@@ -25,46 +25,17 @@ pressure inside it (not modelled).
 
 import sympy as sp
 
-from amble import NONNEGATIVE, POSITIVE, R3, Model, Rx, Ry, Rz, Walker, distance_along_slope, walker
+from amble import Walker
+from amble.models import humanoid_3d_yaw
 
 NAME = "humanoid-3d-level"
 POSITION = 46  # after humanoid-3d-yaw
 
 
-def upper_body_frame(torso, torso_cor, yaw):
-    """Orientation (body → world) of the upper body (pelvis + torso): columns its x, y, z axes."""
-    return Ry(torso) * Rx(-torso_cor) * Rz(yaw)
-
-
 def build() -> Walker:
-    m = Model(NAME, dims=3)
-    st, sw, st_c, sw_c, tor, tor_c, yaw = m.coordinates("stance swing stance_cor swing_cor torso torso_cor yaw")
-    mh, ml, mt, a, b, lt, w, g, slope, i_xy, i_z = m.parameters(
-        mh=10.0, m=5.0, mt=3.0, a=0.53, b=0.47, lt=0.5, w=0.1, g=9.81, slope=0.0, I_xy=0.2, I_z=0.2)
-    gamma = m.parameter("emulated_slope", 0.05, "slope whose gait the controller reproduces", "rad")
-    k_leg, k_sc, kv_sc, k_sw, kv_sw = m.parameters(k_leg=5.0, k_sc=400.0, kv_sc=40.0, k_sw=50.0, kv_sw=20.0)
-    k_t, kv_t, th_d, k_tc, kv_tc, k_y, kv_y = m.parameters(
-        k_t=60.0, kv_t=20.0, torso_d=0.0, k_tc=100.0, kv_tc=20.0, k_yaw=50.0, kv_yaw=10.0)
-    m.restrict("mh m mt a b lt w g", POSITIVE)
-    m.restrict("I_xy I_z k_leg k_sc kv_sc k_sw kv_sw k_t kv_t k_tc kv_tc k_yaw kv_yaw", NONNEGATIVE)
-    frame = upper_body_frame(tor, tor_c, yaw)
-    pelvis = frame[:, 1]
-    m.point("stance_foot", (0, 0, 0))
-    hip_r = m.point("stance_hip", (a + b) * R3(st, st_c), link="stance_foot")
-    m.point("stance_mass", b * R3(st, st_c), mass=ml)
-    hip = m.point("hip", hip_r + w / 2 * pelvis, mass=mh, link="stance_hip")
-    hip_l = m.point("swing_hip", hip_r + w * pelvis, link="hip")
-    m.point("swing_mass", hip_l - a * R3(sw, sw_c), mass=ml)
-    m.point("swing_foot", hip_l - (a + b) * R3(sw, sw_c), link="swing_hip")
-    m.point("torso", hip + lt * R3(tor, tor_c), mass=mt, link="hip")
-    m.body_inertia(frame, sp.diag(i_xy, i_xy, i_z))
-    m.gravity(g)
-    step = -distance_along_slope(m, "swing_foot", slope)  # Eq. 35: > 0 while the swing foot is behind
-    tau_leg = sp.Piecewise((-k_leg * step, step > 0), (0, True))
-    dot = m.dot
-    m.force([0, tau_leg, -k_sc * st_c - kv_sc * dot(st_c), -k_sw * sw_c - kv_sw * dot(sw_c),
-             k_t * (th_d - (tor + gamma)) - kv_t * dot(tor), -k_tc * tor_c - kv_tc * dot(tor_c),
-             -k_y * yaw - kv_y * dot(yaw)])
+    m = humanoid_3d_yaw.model(NAME, slope=0.0, emulated_slope=0.05)
+    st, sw, _, _, tor, _, _ = m.q
+    gamma = m.symbol("emulated_slope")
     # controlled symmetry: inputs on every coordinate (ankle pitch and roll of the stance foot,
     # hip pitch and roll of the swing leg, waist pitch, roll and yaw) replace the potential by
     # the one of the robot turned by γ about the lateral axis
@@ -76,13 +47,6 @@ def build() -> Walker:
         dv = sp.diff(V, q)
         laws[m.actuator(name, on=q)] = dv - dv.xreplace(turned)
     m.control(laws)
-    relabel = {st: sw, sw: st, st_c: -sw_c, sw_c: -st_c, tor: tor, tor_c: -tor_c, yaw: -yaw}
-    # the humanoid-3d fixed point at slope 0.05 (post-impact; step 0.7597 s), turned by γ = 0.05
-    x_slope = [
-        -0.17513872545372786, 0.21584692131603855, -0.0027109889560943323, -0.0007943995955461281,
-        -0.026276535422660098, -0.11538290987512972, -0.005241697963894061, 0.824737150927434,
-        0.6092596999815059, -0.08939453002223806, -0.12489102822875123, 0.1031354286921594,
-        0.4242854569830537, -0.35175036643091706]
-    x_star = [v - (0.05 if i in (0, 1, 4) else 0.0) for i, v in enumerate(x_slope)]
-    return walker(m, foot="swing_foot", hip="hip", slope=slope, relabel=relabel, start=x_star, mirror="y",
-                  doc=__doc__)
+    # the humanoid-3d-yaw fixed point at slope 0.05 (post-impact; step 0.7597 s), turned by γ = 0.05
+    start = [v - (0.05 if i in (0, 1, 4) else 0.0) for i, v in enumerate(humanoid_3d_yaw.FIXED_POINT)]
+    return humanoid_3d_yaw.as_walker(m, start, __doc__)

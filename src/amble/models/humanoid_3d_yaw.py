@@ -58,11 +58,24 @@ def upper_body_frame(torso, torso_cor, yaw):
     return Ry(torso) * Rx(-torso_cor) * Rz(yaw)
 
 
-def build() -> Walker:
-    m = Model(NAME, dims=3)
+#: The stable period-1 fixed point at slope 0.05 (post-impact; step 0.7597 s, |multipliers| ≤ 0.531).
+FIXED_POINT = [
+    -0.17513872545372786, 0.21584692131603855, -0.0027109889560943323, -0.0007943995955461281,
+    -0.026276535422660098, -0.11538290987512972, -0.005241697963894061, 0.824737150927434,
+    0.6092596999815059, -0.08939453002223806, -0.12489102822875123, 0.1031354286921594,
+    0.4242854569830537, -0.35175036643091706]
+
+
+def model(name: str = NAME, slope: float = 0.05, emulated_slope: float | None = None) -> Model:
+    """The robot with its passive and PD forces, before its walker is declared. With
+    ``emulated_slope`` it gains that parameter (rad), and the torso PD holds the torso upright
+    from the vertical of that emulated slope (a controller that turns the robot adds the rest)."""
+    m = Model(name, dims=3)
     st, sw, st_c, sw_c, tor, tor_c, yaw = m.coordinates("stance swing stance_cor swing_cor torso torso_cor yaw")
-    mh, ml, mt, a, b, lt, w, g, slope, i_xy, i_z = m.parameters(
-        mh=10.0, m=5.0, mt=3.0, a=0.53, b=0.47, lt=0.5, w=0.1, g=9.81, slope=0.05, I_xy=0.2, I_z=0.2)
+    mh, ml, mt, a, b, lt, w, g, slope_, i_xy, i_z = m.parameters(
+        mh=10.0, m=5.0, mt=3.0, a=0.53, b=0.47, lt=0.5, w=0.1, g=9.81, slope=slope, I_xy=0.2, I_z=0.2)
+    upright = 0 if emulated_slope is None else m.parameter(
+        "emulated_slope", emulated_slope, "slope whose gait the controller reproduces", "rad")
     k_leg, k_sc, kv_sc, k_sw, kv_sw = m.parameters(k_leg=5.0, k_sc=400.0, kv_sc=40.0, k_sw=50.0, kv_sw=20.0)
     k_t, kv_t, th_d, k_tc, kv_tc, k_y, kv_y = m.parameters(
         k_t=60.0, kv_t=20.0, torso_d=0.0, k_tc=100.0, kv_tc=20.0, k_yaw=50.0, kv_yaw=10.0)
@@ -80,17 +93,23 @@ def build() -> Walker:
     m.point("torso", hip + lt * R3(tor, tor_c), mass=mt, link="hip")
     m.body_inertia(frame, sp.diag(i_xy, i_xy, i_z))
     m.gravity(g)
-    step = -distance_along_slope(m, "swing_foot", slope)  # Eq. 35: > 0 while the swing foot is behind
+    step = -distance_along_slope(m, "swing_foot", slope_)  # Eq. 35: > 0 while the swing foot is behind
     tau_leg = sp.Piecewise((-k_leg * step, step > 0), (0, True))
     dot = m.dot
     m.force([0, tau_leg, -k_sc * st_c - kv_sc * dot(st_c), -k_sw * sw_c - kv_sw * dot(sw_c),
-             k_t * (th_d - tor) - kv_t * dot(tor), -k_tc * tor_c - kv_tc * dot(tor_c), -k_y * yaw - kv_y * dot(yaw)])
+             k_t * (th_d - (tor + upright)) - kv_t * dot(tor), -k_tc * tor_c - kv_tc * dot(tor_c),
+             -k_y * yaw - kv_y * dot(yaw)])
+    return m
+
+
+def as_walker(m: Model, start: list[float], doc: str | None) -> Walker:
+    """The walker of :func:`model`'s robot: heel strike of the swing foot, legs and lateral angles
+    mirrored."""
+    st, sw, st_c, sw_c, tor, tor_c, yaw = m.q
     relabel = {st: sw, sw: st, st_c: -sw_c, sw_c: -st_c, tor: tor, tor_c: -tor_c, yaw: -yaw}
-    # the stable period-1 fixed point (post-impact; step 0.7597 s, |multipliers| ≤ 0.531)
-    x_star = [
-        -0.17513872545372786, 0.21584692131603855, -0.0027109889560943323, -0.0007943995955461281,
-        -0.026276535422660098, -0.11538290987512972, -0.005241697963894061, 0.824737150927434,
-        0.6092596999815059, -0.08939453002223806, -0.12489102822875123, 0.1031354286921594,
-        0.4242854569830537, -0.35175036643091706]
-    return walker(m, foot="swing_foot", hip="hip", slope=slope, relabel=relabel, start=x_star, mirror="y",
-                  doc=__doc__)
+    return walker(m, foot="swing_foot", hip="hip", slope=m.symbol("slope"), relabel=relabel, start=start,
+                  mirror="y", doc=doc)
+
+
+def build() -> Walker:
+    return as_walker(model(), FIXED_POINT, __doc__)
