@@ -138,7 +138,8 @@ def optimize_gait(
     warm: Gait | None = None
     total_iter, total_time = 0, 0.0
 
-    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None, hzd: bool) -> Gait:
+    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None, hzd: bool,
+              feasibility: bool = False, refine: bool = True) -> Gait:
         # ------------------------------------------------------------------ unknowns
         # MX with each model function mapped over the points: the graph holds one copy of each
         # function, not 2N + 1 inlined ones (building the problem is then independent of N)
@@ -202,7 +203,15 @@ def optimize_gait(
         else:
             run = fns.integrand.map(K)(Q, V, U, taus, P)
             scale = 1.0
-        J = scale * h * ca.mtimes(run, wts) / L
+        # per unit distance: with the pace given, the distance is divided by its constrained value
+        # (V T or the step length), not by the foot's position — equal at a feasible point, but away
+        # from one (standing still: the swing foot behind the stance foot, L ≤ 0) L/T is not
+        # bounded away from zero and the objective ∫u²/L is unbounded below
+        dist = speed * Tv if speed is not None else step_length if step_length is not None else L
+        J = scale * h * ca.mtimes(run, wts) / dist
+        if feasibility:
+            # a first solve from a start without motion looks for any step (no objective): see _stages
+            J = ca.MX(0.0)
 
         # ------------------------------------------------------------------ bounds
         lbw, ubw = _bounds(model, fns, bounds, N, t_guess)
@@ -225,7 +234,7 @@ def optimize_gait(
         opts = {"ipopt.tol": tol, "ipopt.constr_viol_tol": min(tol, 1e-10), "ipopt.max_iter": max_iter,
                 "ipopt.print_level": 5 if progress else 0, "print_time": False, "ipopt.sb": "yes",
                 "ipopt.mu_strategy": "adaptive"}
-        if warm is not None:
+        if warm is not None and refine:
             # a finer mesh starts next to the coarse optimum: a small barrier parameter and a start
             # kept where it is (not pushed into the interior) take a handful of iterations instead
             # of re-solving from a central path (RABBIT 20 → 60 intervals: 10 iterations, not 83)
@@ -253,22 +262,69 @@ def optimize_gait(
                      {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed,
                       "nodes": N}, bezier_degree, hzd)
 
-    theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
-    presolve = hzd and not theta[1] - theta[0] > 1e-9
-    if presolve:
-        # the start does not move (standing): no phase to write virtual constraints in; a first
-        # solve without them finds a step, and the virtual constraints start from it
-        levels = [levels[0], *levels]
-    for i, N in enumerate(levels):
-        if warm is not None:  # a finer mesh starts from the coarser solution, interpolated
+    stages = _stages(fns, x_guess, P, levels, hzd)
+    for k, (N, with_vc, feasible, refine) in enumerate(stages):
+        if warm is not None:  # a later stage starts from the previous solution, interpolated
             tau = np.linspace(0.0, warm.step_time, 2 * N + 1)
             x_guess, t_guess = warm.state(tau), warm.step_time
-        warm = solve(N, x_guess, t_guess, warm, hzd and not (presolve and i == 0))
+        warm = solve(N, x_guess, t_guess, warm, with_vc, feasible, refine)
+        if feasible:
+            _unwind(fns, warm, x_guess, P)
         total_iter += warm.solver["iterations"]
         total_time += warm.solver["time_s"]
     assert warm is not None
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
     return warm
+
+
+def _stages(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, levels: list[int], hzd: bool
+            ) -> list[tuple[int, bool, bool, bool]]:
+    """The solves of an optimisation, in order: ``(intervals, virtual constraints, feasibility
+    only, refinement of the previous solve)``.
+
+    A start without motion (standing still: every velocity zero, the phase not advancing) is a
+    degenerate point of the problem: the impact's impulse, the old stance foot's lift-off and the
+    footfall's enabling condition all sit on their bounds (each is linear in the velocities), the
+    phase of the virtual constraints spans nothing, and the objective's Lagrangian pulls the
+    first iterations towards small inputs rather than towards a step. From there IPOPT wanders
+    (RABBIT at 0.8 m/s: the iteration limit, or a gait with its torso below the hip). A first
+    solve of the constraints alone (no objective, no virtual constraints) finds a step in a few
+    iterations; the optimisation, with its virtual constraints, then starts from it.
+    """
+    n = fns.n
+    theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
+    still = not np.any(np.abs(x_guess[:, n:]) > 1e-12) or (hzd and not abs(theta[1] - theta[0]) > 1e-9)
+    first = [(levels[0], False, True, False)] if still else []
+    return [*first, (levels[0], hzd, False, False), *((N, hzd, False, True) for N in levels[1:])]
+
+
+def _unwind(fns: StepFunctions, gait: Gait, x_guess: np.ndarray, P: np.ndarray) -> None:
+    """Bring the coordinates of a first (feasibility) solution back to whole turns of the start.
+
+    Started far from any step, the iterates may land on a copy of a gait with some angles a whole
+    turn away (RABBIT: torso −2π, hips +2π — the same motion). A coordinate is shifted by the
+    multiple of 2π nearest its mean offset from the start only where the shifted step is the same
+    solution: the dynamics, contact force, guard and periodicity residuals unchanged (so the
+    equations are 2π-periodic in it and the relabelling maps the turns consistently)."""
+    n = fns.n
+    X = gait.states
+    turns = np.round(np.mean(X[:, :n] - x_guess[:, :n], axis=0) / (2 * np.pi))
+    if not np.any(turns):
+        return
+    Xs = X.copy()
+    Xs[:, :n] -= 2 * np.pi * turns
+
+    def residuals(Z: np.ndarray) -> np.ndarray:
+        qe = gait.extended_velocity
+        parts = [fns.relabel(Z[-1, :n], qe, P) - Z[0], fns.guard(Z[-1, :n], Z[-1, n:], P)]
+        for j in (0, len(Z) // 2, len(Z) - 1):
+            q, v, a = Z[j, :n], Z[j, n:], gait.accelerations[j]
+            parts += [fns.dynamics(q, v, a, gait.inputs[j], gait.times[j], P), fns.contact(q, v, a, P)]
+        return np.concatenate([np.asarray(r, float).ravel() for r in parts])
+
+    if np.abs(residuals(Xs) - residuals(X)).max() <= 1e-9 * (1 + np.abs(X).max()):
+        gait.states = Xs
+        gait.fixed_point, gait.pre_impact_state = Xs[0].copy(), Xs[-1].copy()
 
 
 def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:
