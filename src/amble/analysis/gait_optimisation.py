@@ -76,7 +76,7 @@ def optimize_gait(
     phase: Any = None,
     max_iter: int = 500,
     tol: float = 1e-10,
-    hzd: bool = False,
+    hzd: bool | None = None,
     progress: bool = False,
 ) -> Gait:
     """A periodic one-step gait of a one-mode walker that minimises ``objective``.
@@ -87,9 +87,12 @@ def optimize_gait(
     list (e.g. ``[20, 60]``) solves on each mesh in turn, each started from the previous solution
     (mesh refinement: the coarse solve finds the gait, the fine one makes it accurate).
     ``guess``: a post-impact state to start from (walked passively for one step where that
-    works), ``"passive"`` (the default: a passive step on the system's own gait), ``"stand"``
-    (standing still in the posture of the system's guess for ``step_time``) or ``"interpolate"``
-    (from that posture to the relabelled one); see :func:`~amble.analysis.gait_start.initial_guess`.
+    works), ``"passive"`` (a passive step on the system's own gait: the default of a model
+    without feedback), ``"stand"`` (standing still in the posture of the system's guess for
+    ``step_time``: the default of a model under feedback, e.g. with virtual constraints) or
+    ``"interpolate"`` (from that posture to the relabelled one); see
+    :func:`~amble.analysis.gait_start.initial_guess`. A start without motion is solved first for
+    the constraints alone (see :func:`_stages`).
     ``posture``: the coordinates (rad, m) of a ``"stand"`` or ``"interpolate"`` start instead of
     the system's guess (e.g. a stride held still in double support).
     ``bounds``: ``{state name: (low, high)}`` limits on coordinates or velocities at every point.
@@ -102,7 +105,7 @@ def optimize_gait(
     ``hzd``: the gait satisfies its virtual constraints exactly — each output is a Bézier
     polynomial (coefficients unknowns of the problem) in the phase at the mesh points — so that
     the HZD controller with the exported ``bezier`` (the optimised ``α``) reproduces it (FROST's
-    formulation).
+    formulation). Default: on for a model that declares virtual constraints, off otherwise.
     ``progress``: solver iterations and constraint violation on stderr.
 
     Raises :class:`ParameterError` / :class:`StateError` / :class:`ModelError` on bad input and
@@ -120,6 +123,8 @@ def optimize_gait(
     if not sizes or not all(isinstance(k, int) and 2 <= k <= 2000 for k in sizes):
         raise ParameterError(f"nodes must be an integer in [2, 2000] (or a list of them), got {nodes!r}")
     vc = getattr(system.modes[system.mode_names[0]], "virtual", None)
+    if hzd is None:
+        hzd = vc is not None
     if bezier_degree is None:
         bezier_degree = vc.degree if vc is not None else 5
     if not (isinstance(bezier_degree, int) and 1 <= bezier_degree <= 20):
@@ -215,6 +220,11 @@ def optimize_gait(
 
         # ------------------------------------------------------------------ bounds
         lbw, ubw = _bounds(model, fns, bounds, N, t_guess)
+        if feasibility:
+            # the step time held at the guess's: free, it collapses to its lower bound (standing
+            # still, the defects h·f of a falling robot shrink with h = T/N), where no step fits
+            it = (3 * n + nu) * K
+            lbw[it] = ubw[it] = t_guess
         lbw = np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)])
         ubw = np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)])
         g = ca.vertcat(*[e for _, e, _, _ in groups])

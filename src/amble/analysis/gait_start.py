@@ -24,7 +24,9 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
                   step_time: float | None, posture: Any = None) -> tuple[np.ndarray, float]:
     """States at the ``2N + 1`` collocation points and the step time (s) to start from.
 
-    ``guess`` ``None``/``"passive"``: the passive walk from the system's fixed-point guess (or
+    ``guess`` ``None``: ``"stand"`` for a model under feedback (virtual constraints or a control
+    law: a step of it is its controller's, not a passive one, and its inputs are unknowns of the
+    optimisation), else ``"passive"``; ``"passive"``: the passive walk from the system's fixed-point guess (or
     default start) settled over a few steps (:func:`~amble.analysis.poincare.default_guess`: a
     stable passive gait where there is one), then one step; a state: one passive step from it;
     ``"stand"``: the posture of the system's guess (or of the given state), held still with zero
@@ -36,7 +38,7 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
     K, n = 2 * N + 1, fns.n
     if isinstance(guess, str) and guess not in GUESSES:
         raise ParameterError(f"guess must be one of {', '.join(GUESSES)} or a state, got {guess!r}")
-    kind = guess if isinstance(guess, str) else ("passive" if guess is None else "state")
+    kind = guess if isinstance(guess, str) else (default_guess_kind(system) if guess is None else "state")
     if kind != "state":
         start = system.fixed_point_guess
         if start is None:
@@ -75,6 +77,15 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
     qN = np.asarray(fns.relabel(q0, np.zeros(n + fns.dims), P), float).ravel()[:n]
     s = np.linspace(0.0, 1.0, K)[:, None]
     return np.hstack([(1 - s) * q0 + s * qN, np.tile((qN - q0) / T, (K, 1))]), T
+
+
+def default_guess_kind(system: HybridSystem) -> str:
+    """``"stand"`` for a system whose first mode has a feedback law (virtual constraints or a
+    control law of its inputs), else ``"passive"``."""
+    m = system.modes[system.mode_names[0]]
+    law = getattr(m, "control_law", None)
+    controlled = getattr(m, "virtual", None) is not None or (law is not None and any(e != 0 for e in law))
+    return "stand" if controlled else "passive"
 
 
 def _passive_step(system: HybridSystem, x0: np.ndarray, params: dict[str, float], step_time: float | None

@@ -115,7 +115,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
                         "coordinates, velocities, inputs and parameters, integrated per m")
     o.add_argument("--nodes", default="30",
                    help="collocation intervals (default 30), or N1,N2,... to refine the mesh (e.g. 20,60)")
-    o.add_argument("--guess", help="'passive' (default: a passive step), 'stand' (standing still), 'interpolate' "
+    o.add_argument("--guess", help="'passive' (a passive step: the default without feedback), 'stand' (standing "
+                                   "still: the default of a model under feedback), 'interpolate' "
                                    "(posture to relabelled posture) or 'x0=V1,V2,...' (a post-impact state "
                                    "walked one step)")
     o.add_argument("--step-time", type=float, dest="step_time",
@@ -126,9 +127,10 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",
                    help="limits of a coordinate or velocity over the step (repeatable; a side may be empty)")
-    o.add_argument("--hzd", action="store_true",
+    o.add_argument("--hzd", action=argparse.BooleanOptionalAction, default=None,
                    help="make the gait satisfy Bézier virtual constraints (their α are optimised too), so "
-                        "that an HZD controller with the exported α reproduces it")
+                        "that an HZD controller with the exported α reproduces it (default: on for a model "
+                        "that declares virtual constraints)")
     o.add_argument("--bezier-degree", type=int, default=None, dest="bezier_degree",
                    help="degree of the Bézier virtual constraints (default: the model's own, else 5)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
