@@ -42,7 +42,8 @@ from ..modelling.hybrid import HybridSystem
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
 from .gait_result import Gait, bezier_fit, constraint_report
-from .gait_start import initial_guess
+from .gait_stages import period_gait, solve_stages, unwind
+from .gait_start import initial_guess, start_vector
 
 OBJECTIVES = ("effort", "cot")
 
@@ -78,6 +79,8 @@ def optimize_gait(
     tol: float = 1e-10,
     hzd: bool | None = None,
     progress: bool = False,
+    steps: int = 1,
+    step_params: Sequence[Mapping[str, float]] | None = None,
 ) -> Gait:
     """A periodic one-step gait of a one-mode walker that minimises ``objective``.
 
@@ -92,7 +95,7 @@ def optimize_gait(
     ``step_time``: the default of a model under feedback, e.g. with virtual constraints) or
     ``"interpolate"`` (from that posture to the relabelled one); see
     :func:`~amble.analysis.gait_start.initial_guess`. A start without motion is solved first for
-    the constraints alone (see :func:`_stages`).
+    the constraints alone (see :func:`~amble.analysis.gait_stages.solve_stages`).
     ``posture``: the coordinates (rad, m) of a ``"stand"`` or ``"interpolate"`` start instead of
     the system's guess (e.g. a stride held still in double support).
     ``bounds``: ``{state name: (low, high)}`` limits on coordinates or velocities at every point.
@@ -131,109 +134,131 @@ def optimize_gait(
         raise ParameterError(f"bezier_degree must be an integer in [1, 20], got {bezier_degree!r}")
     if not (isinstance(max_iter, int) and max_iter >= 1):
         raise ParameterError(f"max_iter must be an integer ≥ 1, got {max_iter!r}")
+    if not (isinstance(steps, int) and 1 <= steps <= 8):
+        raise ParameterError(f"steps must be an integer in [1, 8], got {steps!r}")
+    S = steps
     pvals = _parameters(system, params)
+    if step_params is not None and len(step_params) != S:
+        raise ParameterError(f"step_params must hold one mapping per step ({S}), got {len(step_params)}")
+    pvs = [_parameters(system, {**pvals, **dict(sp_ or {})}) for sp_ in (step_params or [{}] * S)]
     model = system.modes[system.mode_names[0]]
     integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
     fns = step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
     n, nu, d = fns.n, fns.nu, fns.dims
-    P = np.array([pvals[k] for k in fns.param_names])
+    Ps = [np.array([pv[k] for k in fns.param_names]) for pv in pvs]
 
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
-    x_guess, t_guess = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture)
-    warm: Gait | None = None
+    guesses = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture, steps=S)
+    x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
     total_iter, total_time = 0, 0.0
 
-    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None, hzd: bool,
-              feasibility: bool = False, refine: bool = True) -> Gait:
-        # ------------------------------------------------------------------ unknowns
-        # MX with each model function mapped over the points: the graph holds one copy of each
-        # function, not 2N + 1 inlined ones (building the problem is then independent of N)
+    def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
+              feasibility: bool = False, refine: bool = True) -> list[Gait]:
+        """One NLP over the ``S`` steps of a period: a block of unknowns per step ``(X, A, U, T, qe,
+        λ, power, α)``; each step's footfall, impact and relabelling lead into the next step's first
+        state, the last step's into the first's."""
         K = 2 * N + 1
-        X, A, U = ca.MX.sym("x", 2 * n, K), ca.MX.sym("a", n, K), ca.MX.sym("u", nu, K)
-        Tv, QE, LAM = ca.MX.sym("T"), ca.MX.sym("qe", n + d), ca.MX.sym("lam", d)
         cot = isinstance(objective, str) and objective == "cot"
-        PW = ca.MX.sym("power", 2 * nu if cot else 0, K)  # positive and negative parts of each input's power
         Mb = bezier_degree
-        AL = ca.MX.sym("alpha", nu if hzd else 0, Mb + 1)  # Bézier coefficients of the virtual constraints
-        w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(AL))
-        h = Tv / N
-        taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
-        Q, V = X[:n, :], X[n:, :]
-        F = ca.vertcat(V, A)
-
         groups: list[tuple[str, Any, float, float]] = []  # (name, expression, lower, upper)
 
         def add(name: str, expr: Any, lo: float = 0.0, hi: float = 0.0) -> None:
             if expr.numel():
                 groups.append((name, ca.vec(expr), lo, hi))
 
-        add("dynamics", fns.dynamics.map(K)(Q, V, A, U, taus, P))
-        add("collocation", ca.vertcat(*defects([X[:, 0:-1:2], X[:, 1::2], X[:, 2::2]],
-                                               [F[:, 0:-1:2], F[:, 1::2], F[:, 2::2]], h)))
-        qN, vN = X[:n, -1], X[n:, -1]
-        add("impact", fns.impact(qN, vN, QE, LAM, P))
-        add("periodicity", fns.relabel(qN, QE, P) - X[:, 0])
-        add("guard", fns.guard(qN, vN, P))
-        add("guard_enabled", fns.enabled(qN, vN, P), 0.0, np.inf)
-        L = fns.distance(qN, P)
-        if speed is not None:
-            add("speed", L - speed * Tv)
-        elif step_length is not None:
-            add("step_length", L - step_length)
-        nrm = fns.normal(P)
-        add("impact_impulse", ca.dot(nrm, LAM), 0.0, np.inf)
-        add("liftoff", ca.dot(nrm, QE[n:]), 0.0, np.inf)
-        forces = fns.contact.map(K)(Q, V, A, P)  # d × K
-        normals = ca.mtimes(nrm.T, forces)
-        add("contact", normals, 0.0, np.inf)
-        if mu is not None:
-            tangential = forces - ca.mtimes(nrm, normals)
-            add("friction", mu**2 * normals**2 - ca.sum1(tangential**2), 0.0, np.inf)
-        if clearance is not None and K > 2:
-            s_ = np.arange(1, K - 1) / (K - 1)
-            lift = fns.guard.map(K - 2)(Q[:, 1:-1], V[:, 1:-1], P)
-            add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
-        if hzd:
-            add("virtual_constraints", virtual_constraints(fns, X, P, x_guess, AL))
-
-        # ------------------------------------------------------------------ objective
+        ws, lbws, ubws, w0s, bound_groups = [], [], [], [], []
+        Xs, QEs, Ts, integrals, dists, Ls = [], [], [], [], [], []
         wts = ca.DM(simpson_weights(N))
-        if objective == "effort":
-            run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
-            scale = 1.0
-        elif cot:
-            add("power", U * fns.actuator_rates.map(K)(Q, V, P) - (PW[:nu, :] - PW[nu:, :]))
-            run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
-            scale = 1.0 / float(fns.weight(P))
-        else:
-            run = fns.integrand.map(K)(Q, V, U, taus, P)
-            scale = 1.0
-        # per unit distance: with the pace given, the distance is divided by its constrained value
-        # (V T or the step length), not by the foot's position — equal at a feasible point, but away
-        # from one (standing still: the swing foot behind the stance foot, L ≤ 0) L/T is not
-        # bounded away from zero and the objective ∫u²/L is unbounded below
-        dist = speed * Tv if speed is not None else step_length if step_length is not None else L
-        J = scale * h * ca.mtimes(run, wts) / dist
+        offset = 0
+        for j in range(S):
+            Pj, xg, tg, wj = Ps[j], x_guesses[j], t_guesses[j], warms[j] if warms else None
+            # MX with each model function mapped over the points: the graph holds one copy of each
+            # function, not 2N + 1 inlined ones (building the problem is then independent of N)
+            X, A, U = ca.MX.sym(f"x{j}", 2 * n, K), ca.MX.sym(f"a{j}", n, K), ca.MX.sym(f"u{j}", nu, K)
+            Tv, QE, LAM = ca.MX.sym(f"T{j}"), ca.MX.sym(f"qe{j}", n + d), ca.MX.sym(f"lam{j}", d)
+            PW = ca.MX.sym(f"power{j}", 2 * nu if cot else 0, K)  # positive and negative parts of each power
+            AL = ca.MX.sym(f"alpha{j}", nu if hzd else 0, Mb + 1)  # Bézier coefficients of the virtual constraints
+            w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(AL))
+            h = Tv / N
+            taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
+            Q, V = X[:n, :], X[n:, :]
+            F = ca.vertcat(V, A)
+            add("dynamics", fns.dynamics.map(K)(Q, V, A, U, taus, Pj))
+            add("collocation", ca.vertcat(*defects([X[:, 0:-1:2], X[:, 1::2], X[:, 2::2]],
+                                                   [F[:, 0:-1:2], F[:, 1::2], F[:, 2::2]], h)))
+            qN, vN = X[:n, -1], X[n:, -1]
+            add("impact", fns.impact(qN, vN, QE, LAM, Pj))
+            add("guard", fns.guard(qN, vN, Pj))
+            add("guard_enabled", fns.enabled(qN, vN, Pj), 0.0, np.inf)
+            L = fns.distance(qN, Pj)
+            if step_length is not None:
+                add("step_length", L - step_length)
+            nrm = fns.normal(Pj)
+            add("impact_impulse", ca.dot(nrm, LAM), 0.0, np.inf)
+            add("liftoff", ca.dot(nrm, QE[n:]), 0.0, np.inf)
+            forces = fns.contact.map(K)(Q, V, A, Pj)  # d × K
+            normals = ca.mtimes(nrm.T, forces)
+            add("contact", normals, 0.0, np.inf)
+            if mu is not None:
+                tangential = forces - ca.mtimes(nrm, normals)
+                add("friction", mu**2 * normals**2 - ca.sum1(tangential**2), 0.0, np.inf)
+            if clearance is not None and K > 2:
+                s_ = np.arange(1, K - 1) / (K - 1)
+                lift = fns.guard.map(K - 2)(Q[:, 1:-1], V[:, 1:-1], Pj)
+                add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
+            if hzd:
+                add("virtual_constraints", virtual_constraints(fns, X, Pj, xg, AL))
+            if objective == "effort":
+                run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
+                scale = 1.0
+            elif cot:
+                add("power", U * fns.actuator_rates.map(K)(Q, V, Pj) - (PW[:nu, :] - PW[nu:, :]))
+                run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
+                scale = 1.0 / float(fns.weight(Pj))
+            else:
+                run = fns.integrand.map(K)(Q, V, U, taus, Pj)
+                scale = 1.0
+            integrals.append(scale * h * ca.mtimes(run, wts))
+            # per unit distance: with the pace given, the distance is divided by its constrained
+            # value (V T or the step length), not by the foot's position — equal at a feasible
+            # point, but away from one (standing still: the swing foot behind the stance foot,
+            # L ≤ 0) L is not bounded away from zero and the objective ∫u²/L is unbounded below
+            dists.append(speed * Tv if speed is not None else step_length if step_length is not None else L)
+            Xs.append(X)
+            QEs.append(QE)
+            Ts.append(Tv)
+            Ls.append(L)
+            # bounds
+            lbw, ubw = _bounds(model, fns, bounds, N, tg)
+            if feasibility:
+                # the step time held at the guess's: free, it collapses to its lower bound (standing
+                # still, the defects h·f of a falling robot shrink with h = T/N), where no step fits
+                it = (3 * n + nu) * K
+                lbw[it] = ubw[it] = tg
+            lbws.append(np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)]))
+            ubws.append(np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)]))
+            alpha0 = (np.array(wj.bezier["alpha"]) if hzd and wj is not None and wj.bezier
+                      else bezier_start(fns, xg, Pj, Mb) if hzd else np.zeros(0))
+            w0s.append(np.concatenate([start_vector(fns, xg, tg, N, Pj, wj), np.zeros(PW.numel()),
+                                       alpha0.ravel(order="F")]))
+            bound_groups += [(name, offset + lo, offset + hi) for name, lo, hi in _bound_groups(fns, N)]
+            offset += w.numel()
+            ws.append(w)
+        for j in range(S):  # each footfall leads into the next step (the last into the first)
+            qN = Xs[j][:n, -1]
+            add("periodicity", fns.relabel(qN, QEs[j], Ps[j]) - Xs[(j + 1) % S][:, 0])
+        if speed is not None:  # the pace of the whole period
+            add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
+        J = sum(integrals[1:], integrals[0]) / sum(dists[1:], dists[0])
         if feasibility:
-            # a first solve from a start without motion looks for any step (no objective): see _stages
+            # a first solve from a start without motion looks for any step (no objective): see gait_stages.solve_stages
             J = ca.MX(0.0)
-
-        # ------------------------------------------------------------------ bounds
-        lbw, ubw = _bounds(model, fns, bounds, N, t_guess)
-        if feasibility:
-            # the step time held at the guess's: free, it collapses to its lower bound (standing
-            # still, the defects h·f of a falling robot shrink with h = T/N), where no step fits
-            it = (3 * n + nu) * K
-            lbw[it] = ubw[it] = t_guess
-        lbw = np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)])
-        ubw = np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)])
+        w = ca.vertcat(*ws)
+        lbw, ubw = np.concatenate(lbws), np.concatenate(ubws)
+        w0 = np.concatenate(w0s)
         g = ca.vertcat(*[e for _, e, _, _ in groups])
         lbg = np.concatenate([np.full(e.numel(), lo) for _, e, lo, _ in groups])
         ubg = np.concatenate([np.full(e.numel(), hi) for _, e, _, hi in groups])
-        alpha0 = (np.array(warm.bezier["alpha"]) if hzd and warm is not None and warm.bezier
-                  else bezier_start(fns, x_guess, P, Mb) if hzd else np.zeros(0))
-        w0 = np.concatenate([_start_vector(fns, x_guess, t_guess, N, P, warm), np.zeros(PW.numel()),
-                             alpha0.ravel(order="F")])
         n_eq = int(np.sum(lbg == ubg))
         if n_eq > w.numel():
             pace = " and a speed or step length" if (speed or step_length) else ""
@@ -244,7 +269,7 @@ def optimize_gait(
         opts = {"ipopt.tol": tol, "ipopt.constr_viol_tol": min(tol, 1e-10), "ipopt.max_iter": max_iter,
                 "ipopt.print_level": 5 if progress else 0, "print_time": False, "ipopt.sb": "yes",
                 "ipopt.mu_strategy": "adaptive"}
-        if warm is not None and refine:
+        if warms is not None and refine:
             # a finer mesh starts next to the coarse optimum: a small barrier parameter and a start
             # kept where it is (not pushed into the interior) take a handful of iterations instead
             # of re-solving from a central path (RABBIT 20 → 60 intervals: 10 iterations, not 83)
@@ -258,7 +283,7 @@ def optimize_gait(
         stats = solver.stats()
         wopt = np.asarray(sol["x"]).ravel()
         gval = np.asarray(sol["g"]).ravel()
-        report = constraint_report(groups, gval, lbg, ubg, wopt, lbw, ubw, _bound_groups(fns, N))
+        report = constraint_report(groups, gval, lbg, ubg, wopt, lbw, ubw, bound_groups)
         status = stats.get("return_status", "unknown")
         if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
             worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
@@ -268,73 +293,30 @@ def optimize_gait(
                        else "every constraint holds at the last iterate (the optimality conditions do not)")
             raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
                               f"{binding}")
-        return _gait(system, model, fns, pvals, wopt, N, objective, float(sol["f"]), report,
-                     {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed,
-                      "nodes": N}, bezier_degree, hzd)
+        info = {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed, "nodes": N}
+        out, start = [], 0
+        for j in range(S):
+            size = ws[j].numel()
+            out.append(_gait(system, model, fns, pvs[j], wopt[start:start + size], N, objective, float(sol["f"]),
+                             report, dict(info), bezier_degree, hzd))
+            start += size
+        return out
 
-    stages = _stages(fns, x_guess, P, levels, hzd)
-    for k, (N, with_vc, feasible, refine) in enumerate(stages):
-        if warm is not None:  # a later stage starts from the previous solution, interpolated
-            tau = np.linspace(0.0, warm.step_time, 2 * N + 1)
-            x_guess, t_guess = warm.state(tau), warm.step_time
-        warm = solve(N, x_guess, t_guess, warm, with_vc, feasible, refine)
-        if feasible:
-            _unwind(fns, warm, x_guess, P)
-        total_iter += warm.solver["iterations"]
-        total_time += warm.solver["time_s"]
-    assert warm is not None
+    stages = solve_stages(fns, x_guesses[0], Ps[0], levels, hzd)
+    warms: list[Gait] | None = None
+    for N, with_vc, feasible, refine in stages:
+        if warms is not None:  # a later stage starts from the previous solution, interpolated
+            x_guesses = [wg.state(np.linspace(0.0, wg.step_time, 2 * N + 1)) for wg in warms]
+            t_guesses = [wg.step_time for wg in warms]
+        warms = solve(N, x_guesses, t_guesses, warms, with_vc, feasible, refine)
+        if feasible and S == 1:
+            unwind(fns, warms[0], x_guesses[0], Ps[0])
+        total_iter += warms[0].solver["iterations"]
+        total_time += warms[0].solver["time_s"]
+    assert warms is not None
+    warm = warms[0] if S == 1 else period_gait(warms)
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
     return warm
-
-
-def _stages(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, levels: list[int], hzd: bool
-            ) -> list[tuple[int, bool, bool, bool]]:
-    """The solves of an optimisation, in order: ``(intervals, virtual constraints, feasibility
-    only, refinement of the previous solve)``.
-
-    A start without motion (standing still: every velocity zero, the phase not advancing) is a
-    degenerate point of the problem: the impact's impulse, the old stance foot's lift-off and the
-    footfall's enabling condition all sit on their bounds (each is linear in the velocities), the
-    phase of the virtual constraints spans nothing, and the objective's Lagrangian pulls the
-    first iterations towards small inputs rather than towards a step. From there IPOPT wanders
-    (RABBIT at 0.8 m/s: the iteration limit, or a gait with its torso below the hip). A first
-    solve of the constraints alone (no objective, no virtual constraints) finds a step in a few
-    iterations; the optimisation, with its virtual constraints, then starts from it.
-    """
-    n = fns.n
-    theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
-    still = not np.any(np.abs(x_guess[:, n:]) > 1e-12) or (hzd and not abs(theta[1] - theta[0]) > 1e-9)
-    first = [(levels[0], False, True, False)] if still else []
-    return [*first, (levels[0], hzd, False, False), *((N, hzd, False, True) for N in levels[1:])]
-
-
-def _unwind(fns: StepFunctions, gait: Gait, x_guess: np.ndarray, P: np.ndarray) -> None:
-    """Bring the coordinates of a first (feasibility) solution back to whole turns of the start.
-
-    Started far from any step, the iterates may land on a copy of a gait with some angles a whole
-    turn away (RABBIT: torso −2π, hips +2π — the same motion). A coordinate is shifted by the
-    multiple of 2π nearest its mean offset from the start only where the shifted step is the same
-    solution: the dynamics, contact force, guard and periodicity residuals unchanged (so the
-    equations are 2π-periodic in it and the relabelling maps the turns consistently)."""
-    n = fns.n
-    X = gait.states
-    turns = np.round(np.mean(X[:, :n] - x_guess[:, :n], axis=0) / (2 * np.pi))
-    if not np.any(turns):
-        return
-    Xs = X.copy()
-    Xs[:, :n] -= 2 * np.pi * turns
-
-    def residuals(Z: np.ndarray) -> np.ndarray:
-        qe = gait.extended_velocity
-        parts = [fns.relabel(Z[-1, :n], qe, P) - Z[0], fns.guard(Z[-1, :n], Z[-1, n:], P)]
-        for j in (0, len(Z) // 2, len(Z) - 1):
-            q, v, a = Z[j, :n], Z[j, n:], gait.accelerations[j]
-            parts += [fns.dynamics(q, v, a, gait.inputs[j], gait.times[j], P), fns.contact(q, v, a, P)]
-        return np.concatenate([np.asarray(r, float).ravel() for r in parts])
-
-    if np.abs(residuals(Xs) - residuals(X)).max() <= 1e-9 * (1 + np.abs(X).max()):
-        gait.states = Xs
-        gait.fixed_point, gait.pre_impact_state = Xs[0].copy(), Xs[-1].copy()
 
 
 def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:
@@ -399,23 +381,6 @@ def _bound_groups(fns: StepFunctions, N: int) -> list[tuple[str, int, int]]:
     s = 2 * n * K + n * K
     return [("joint_limits", 0, 2 * n * K), ("actuator_limits", s, s + nu * K), ("step_time", s + nu * K,
                                                                                    s + nu * K + 1)]
-
-
-def _start_vector(fns: StepFunctions, x: np.ndarray, T: float, N: int, P: np.ndarray, warm: Gait | None = None
-                  ) -> np.ndarray:
-    """Unknowns from a guessed trajectory ``x`` (``(2N + 1) × 2n``): accelerations by differences,
-    inputs zero, the impact's unknowns from the guessed pre-impact state; from a coarser solution
-    ``warm``, its accelerations, inputs and impulse interpolated."""
-    n, nu, d, K = fns.n, fns.nu, fns.dims, 2 * N + 1
-    tau = np.linspace(0.0, T, K)
-    a = np.gradient(x[:, n:], tau, axis=0) if K > 2 else np.zeros((K, n))
-    u = np.zeros((K, nu))
-    qe, lam = np.concatenate([x[-1, n:], np.zeros(d)]), np.zeros(d)
-    if warm is not None:
-        a = np.column_stack([np.interp(tau, warm.times, warm.accelerations[:, i]) for i in range(n)])
-        u = warm.input(tau) if nu else u
-        qe, lam = warm.extended_velocity, warm.impulse
-    return np.concatenate([x.ravel(), a.ravel(), u.ravel(), [T], qe, lam])
 
 
 def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: np.ndarray, N: int,
