@@ -66,6 +66,8 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--bezier-degree must be in [1, 20], got {args.bezier_degree}")
     if args.max_iter < 1:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
+    if not 1 <= args.steps <= 8:
+        raise UsageError(f"--steps must be in [1, 8], got {args.steps}")
     bounds = parse_bounds(args.bound)
     guess = _guess(args.guess)
     s = load_model(args.model)
@@ -80,7 +82,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
                          nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time,
                          posture=posture, mu=args.mu,
                          clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, hzd=args.hzd,
-                         bezier_degree=args.bezier_degree, progress=not args.quiet)
+                         bezier_degree=args.bezier_degree, progress=not args.quiet, steps=args.steps)
     out = gait.to_json()
     if out_p:
         write_output(out_p, gait.save, "--out")
@@ -92,6 +94,8 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
               f"step length {gait.step_length:.6g} m, speed {gait.speed:.6g} m/s ({its} iterations, {secs:.2f} s "
               f"in the solver, max violation {gait.max_violation:.1e})")
         print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(gait.state_names, gait.fixed_point)))
+        for j, step in enumerate(gait.steps or []):
+            print(f"step {j + 1}: step time {step.step_time:.6g} s, step length {step.step_length:.6g} m")
         active = [k for k, r in gait.constraints.items() if r["active"]]
         if active:
             print("active constraints: " + ", ".join(active))
@@ -133,6 +137,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
                         "that declares virtual constraints)")
     o.add_argument("--bezier-degree", type=int, default=None, dest="bezier_degree",
                    help="degree of the Bézier virtual constraints (default: the model's own, else 5)")
+    o.add_argument("--steps", type=int, default=1,
+                   help="steps per period (default 1; 2: a two-step gait, each step with its own impact)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")
