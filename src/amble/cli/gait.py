@@ -131,7 +131,9 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",
                    help="limits of a coordinate or velocity over the step (repeatable; a side may be empty)")
-    o.add_argument("--hzd", action=argparse.BooleanOptionalAction, default=None,
+    o.add_argument("--no-hzd", action="store_false", dest="hzd",
+                   help="no virtual constraints, even for a model that declares them")
+    o.add_argument("--hzd", action="store_true", default=None,
                    help="make the gait satisfy Bézier virtual constraints (their α are optimised too), so "
                         "that an HZD controller with the exported α reproduces it (default: on for a model "
                         "that declares virtual constraints)")
