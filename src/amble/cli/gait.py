@@ -144,4 +144,4 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")
-    o.set_defaults(func=cmd_optimize_gait)
+    o.set_defaults(func=cmd_optimize_gait, hzd=None)  # None: the model decides (see optimize_gait)
