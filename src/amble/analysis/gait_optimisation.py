@@ -1,4 +1,5 @@
-"""Gait design by optimisation: one periodic step of a walker by direct collocation.
+"""Gait design by optimisation: one periodic step of a walker (or a period of several steps,
+``steps=2``) by direct collocation.
 
 The unknowns are the states, accelerations and inputs at the ``2N + 1`` Hermite–Simpson points of
 one step (:mod:`amble.analysis.collocation`), the free step time ``T``, and the impact's
@@ -21,7 +22,8 @@ Objectives, all per unit distance walked: ``effort`` ``(1/L) ∫ ‖u‖² dt``,
 transport) ``(1/(mₜ g L)) ∫ Σ |u_j v_j| dt`` with ``v = Bᵀq̇`` (each power split into its positive
 and negative parts, ``u_j v_j = p⁺ − p⁻``, ``p± ≥ 0``, so that ``|u_j v_j| = p⁺ + p⁻`` at the optimum
 without a kink), or a user expression
-``c(q, q̇, u)``: ``(1/L) ∫ c dt``. CasADi builds the problem from amble's derived expressions
+``c(q, q̇, u)``: ``(1/L) ∫ c dt``. With a pace given, ``L`` in the objective is its constrained value
+(``V T`` or the step length), which keeps the objective bounded away from feasible points. CasADi builds the problem from amble's derived expressions
 (:mod:`amble.backend.casadi_export`) with exact sparse first and second derivatives; IPOPT solves it.
 """
 
@@ -110,6 +112,12 @@ def optimize_gait(
     the HZD controller with the exported ``bezier`` (the optimised ``α``) reproduces it (FROST's
     formulation). Default: on for a model that declares virtual constraints, off otherwise.
     ``progress``: solver iterations and constraint violation on stderr.
+    ``steps``: steps per period (default 1). With ``steps=2`` each step has its own unknowns,
+    footfall, impact and relabelling into the next step (the last into the first); a ``speed``
+    holds over the period, a ``step_length`` for each step, the objective is the period's per unit
+    distance; ``step_params`` (one mapping per step) overrides parameter values step by step
+    (e.g. leg masses of a robot whose legs differ, swapped from one step to the next). The
+    result's fields are the first step's and :attr:`Gait.steps` holds every step.
 
     Raises :class:`ParameterError` / :class:`StateError` / :class:`ModelError` on bad input and
     :class:`SolverError` (naming the reason and the most violated constraint) when IPOPT fails.
