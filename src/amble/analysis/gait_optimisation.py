@@ -23,8 +23,9 @@ transport) ``(1/(mₜ g L)) ∫ Σ |u_j v_j| dt`` with ``v = Bᵀq̇`` (each pow
 and negative parts, ``u_j v_j = p⁺ − p⁻``, ``p± ≥ 0``, so that ``|u_j v_j| = p⁺ + p⁻`` at the optimum
 without a kink), or a user expression
 ``c(q, q̇, u)``: ``(1/L) ∫ c dt``. With a pace given, ``L`` in the objective is its constrained value
-(``V T`` or the step length), which keeps the objective bounded away from feasible points. CasADi builds the problem from amble's derived expressions
-(:mod:`amble.backend.casadi_export`) with exact sparse first and second derivatives; IPOPT solves it.
+(``V T`` or the step length), which keeps the objective bounded away from feasible points.
+CasADi builds the problem from amble's derived expressions (:mod:`amble.backend.casadi_export`)
+with exact sparse first and second derivatives; IPOPT solves it.
 """
 
 from __future__ import annotations
