@@ -45,7 +45,7 @@ from ..modelling.hybrid import HybridSystem
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
 from .gait_result import Gait, bezier_fit, constraint_report
-from .gait_stages import period_gait, solve_stages, unwind
+from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
 
 OBJECTIVES = ("effort", "cot")
@@ -318,8 +318,6 @@ def optimize_gait(
             x_guesses = [wg.state(np.linspace(0.0, wg.step_time, 2 * N + 1)) for wg in warms]
             t_guesses = [wg.step_time for wg in warms]
         warms = solve(N, x_guesses, t_guesses, warms, with_vc, feasible, refine)
-        if feasible and S == 1:
-            unwind(fns, warms[0], x_guesses[0], Ps[0])
         total_iter += warms[0].solver["iterations"]
         total_time += warms[0].solver["time_s"]
     assert warms is not None

@@ -29,40 +29,12 @@ def solve_stages(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, levels:
     phase of the virtual constraints spans nothing, and the objective's Lagrangian pulls the
     first iterations towards small inputs rather than towards a step. From there IPOPT wanders
     (RABBIT at 0.8 m/s: the iteration limit, or a gait with its torso below the hip). A first
-    solve of the constraints alone (no objective, no virtual constraints) finds a step in a few
-    iterations; the optimisation, with its virtual constraints, then starts from it.
+    solve of the constraints alone (no objective, no virtual constraints, the step time held at
+    the guess's: free, it collapses to its lower bound) finds a step in a few iterations (RABBIT:
+    12); the optimisation, with its virtual constraints, then starts from it.
     """
     n = fns.n
     theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
     still = not np.any(np.abs(x_guess[:, n:]) > 1e-12) or (hzd and not abs(theta[1] - theta[0]) > 1e-9)
     first = [(levels[0], False, True, False)] if still else []
     return [*first, (levels[0], hzd, False, False), *((N, hzd, False, True) for N in levels[1:])]
-
-
-def unwind(fns: StepFunctions, gait: Gait, x_guess: np.ndarray, P: np.ndarray) -> None:
-    """Bring the coordinates of a first (feasibility) solution back to whole turns of the start.
-
-    Started far from any step, the iterates may land on a copy of a gait with some angles a whole
-    turn away (RABBIT: torso −2π, hips +2π — the same motion). A coordinate is shifted by the
-    multiple of 2π nearest its mean offset from the start only where the shifted step is the same
-    solution: the dynamics, contact force, guard and periodicity residuals unchanged (so the
-    equations are 2π-periodic in it and the relabelling maps the turns consistently)."""
-    n = fns.n
-    X = gait.states
-    turns = np.round(np.mean(X[:, :n] - x_guess[:, :n], axis=0) / (2 * np.pi))
-    if not np.any(turns):
-        return
-    Xs = X.copy()
-    Xs[:, :n] -= 2 * np.pi * turns
-
-    def residuals(Z: np.ndarray) -> np.ndarray:
-        qe = gait.extended_velocity
-        parts = [fns.relabel(Z[-1, :n], qe, P) - Z[0], fns.guard(Z[-1, :n], Z[-1, n:], P)]
-        for j in (0, len(Z) // 2, len(Z) - 1):
-            q, v, a = Z[j, :n], Z[j, n:], gait.accelerations[j]
-            parts += [fns.dynamics(q, v, a, gait.inputs[j], gait.times[j], P), fns.contact(q, v, a, P)]
-        return np.concatenate([np.asarray(r, float).ravel() for r in parts])
-
-    if np.abs(residuals(Xs) - residuals(X)).max() <= 1e-9 * (1 + np.abs(X).max()):
-        gait.states = Xs
-        gait.fixed_point, gait.pre_impact_state = Xs[0].copy(), Xs[-1].copy()
