@@ -48,12 +48,13 @@ import weakref
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import CompileError
-from ..modelling.dag import dag_srepr
-from ..modelling.hybrid import HybridSystem
 from ..version import __version__
+
+if TYPE_CHECKING:  # the lookup of a warm cache imports no SymPy (see backend/index.py)
+    from ..modelling.hybrid import HybridSystem
 
 C_DIR = Path(str(resources.files("amble.backend") / "_c"))
 _PKG = Path(__file__).resolve().parents[1]
@@ -172,6 +173,8 @@ def toolchain() -> str:
 
 def _structure_digest(system: HybridSystem) -> str:
     """Hash of the system's structure (not parameter values or defaults)."""
+    from ..modelling.dag import dag_srepr  # SymPy: only when a key is computed from a system
+
     h = hashlib.sha256()
     for name, m in system.modes.items():
         parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]

@@ -12,14 +12,16 @@ from __future__ import annotations
 import copy
 import ctypes
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import CompileError, ModelError, StateError
-from ..modelling.hybrid import HybridSystem
 from . import abi, cache
 from .cache import cache_dir, structure_key
+
+if TYPE_CHECKING:  # loading a cached library imports no SymPy
+    from ..modelling.hybrid import HybridSystem
 
 __all__ = ["Kernels", "build", "cache_dir", "structure_key"]
 

@@ -21,7 +21,6 @@ from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
-from .equations import cmd_equations
 from .gait import add_parser as add_gait_parser
 from .output import write_output
 
@@ -190,6 +189,12 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
             if k in out:
                 print(f"wrote {out[k]}")
     return out
+
+
+def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
+    from .equations import cmd_equations as run  # SymPy's printers: only for this command
+
+    return run(args)
 
 
 def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
