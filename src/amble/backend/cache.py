@@ -46,7 +46,6 @@ import time
 import warnings
 import weakref
 from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -56,7 +55,7 @@ from ..version import __version__
 if TYPE_CHECKING:  # the lookup of a warm cache imports no SymPy (see backend/index.py)
     from ..modelling.hybrid import HybridSystem
 
-C_DIR = Path(str(resources.files("amble.backend") / "_c"))
+C_DIR = Path(__file__).resolve().parent / "_c"  # a package on disk (importlib.resources costs ~10 ms)
 _PKG = Path(__file__).resolve().parents[1]
 
 #: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.

@@ -38,7 +38,17 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
     ``derivatives``: also the derivative kernels (flow and reset Jacobians, guard gradients) that
     sensitivity runs, exact return-map Jacobians and the implicit integrator need. They are
     several times longer than the rest, so a library is built with them only when asked; one that
-    has them serves plain runs too, and is preferred when it is at hand."""
+    has them serves plain runs too, and is preferred when it is at hand.
+
+    A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
+    found by the warm-start index) is served those; without the ones asked for, its full system
+    is built."""
+    carried = getattr(type(system), "compiled_kernels", None)
+    if carried is not None:
+        k = carried(system, derivatives)
+        if k is not None:
+            return k
+        system = system.full()
     plain = cache.structure_key(system)
     full = cache.derivatives_key(plain)
     k = _LOADED.get(full) or (None if derivatives else _LOADED.get(plain))

@@ -90,7 +90,10 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--steps must be at least 1 and at most {most}, got {args.steps}")
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
-    s = load_model(args.model)
+    drawn = bool(plot_p or anim_p)
+    s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or args.method == "radau")
+    if out_p and hasattr(s, "full") and any(m.inputs for m in s.modes.values()):
+        s = s.full()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
@@ -142,13 +145,17 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         check_writer(anim_p)
     if not 1 <= args.period <= MAX_PERIOD:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
-    s = load_model(args.model)
+    # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
+    s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True)
     params = parse_sets(args.set)
     guess = _start(s, args.guess, params) if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
     out = lc.to_json()
     if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
         from ..analysis.gait_check import check_gait
+
+        if hasattr(s, "full"):  # the checks read the symbolic model (contact forces, the control law)
+            lc.hybrid_system = s.full()
 
         # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
         gait = lc.trajectory(steps=lc.period)

@@ -108,7 +108,7 @@ def source_files(spec: str) -> list[Path]:
     ``path.py[:callable]`` (what it reads while it runs is found by :func:`load_traced`)."""
     if is_file_spec(spec):
         return [Path(_split_spec(spec)[0]).resolve()]
-    return sorted(Path(d) / f"{info.name}.py" for d in __path__ for info in pkgutil.iter_modules([d]))
+    return sorted(f.resolve() for d in __path__ for f in Path(d).glob("*.py"))
 
 
 def load_traced(spec: str) -> tuple[HybridSystem, list[Path]]:
