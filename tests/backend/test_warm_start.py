@@ -103,7 +103,7 @@ def test_a_module_the_model_file_imports_is_watched(cache, tmp_path):
     (tmp_path / "ball_height.py").write_text("Z0 = 2.0\n", encoding="utf-8")
     f = tmp_path / "ball.py"
     src = BALL.format(g=9.81, z0="ball_height.Z0", gravity="g")
-    f.write_text("import sys\nsys.path.insert(0, %r)\nimport ball_height\n%s" % (str(tmp_path), src), encoding="utf-8")
+    f.write_text(f"import sys\nsys.path.insert(0, {str(tmp_path)!r})\nimport ball_height\n{src}", encoding="utf-8")
     _fall_time(load_model(str(f), compiled=True))
     assert isinstance(load_model(str(f), compiled=True), CompiledSystem)
     (tmp_path / "ball_height.py").write_text("Z0 = 8.0\n", encoding="utf-8")

@@ -108,7 +108,8 @@ class CompiledSystem:
         self.modes = {mode: _Info({"inputs": m["inputs"], "state_names": m["state_names"]},
                                   lambda mode=mode: self.full().modes[mode])
                       for mode, m in info["modes"].items()}
-        self.transitions = [_Info(tr, lambda i=i: self.full().transitions[i]) for i, tr in enumerate(info["transitions"])]
+        self.transitions = [_Info(tr, lambda i=i: self.full().transitions[i])
+                            for i, tr in enumerate(info["transitions"])]
         self._kernels: dict[bool, Kernels] = {}
         for derivatives, (so, meta) in libraries.items():
             k = Kernels(so, meta)
