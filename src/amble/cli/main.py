@@ -222,7 +222,16 @@ EXAMPLES = {
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
+class _Unused:
+    """Stands in for the parser of a command that is not being run: every call is accepted and
+    does nothing (building all seven parsers costs more than a warm limit cycle's search)."""
+
+    def __getattr__(self, name: str) -> Any:
+        return lambda *a, **k: self
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The command-line parser; ``only``: build that command's sub-parser alone (the one being run)."""
     p = _Parser(prog="amble", description="Equation-based modeling and simulation of walking robots.",
                 formatter_class=argparse.RawDescriptionHelpFormatter,
                 epilog="examples:\n  " + "\n  ".join(EXAMPLES.values()))
@@ -230,6 +239,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", parser_class=_Parser, required=True)
 
     def add(name: str, help_: str) -> argparse.ArgumentParser:
+        if only is not None and name != only:
+            return _Unused()  # type: ignore[return-value]
         sp = sub.add_parser(name, help=help_, description=help_, epilog=f"example:\n  {EXAMPLES[name]}",
                             formatter_class=argparse.RawDescriptionHelpFormatter)
         sp.add_argument("--json", action="store_true", help="print a JSON object on stdout")
@@ -329,7 +340,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: list[str]) -> int:
     want_json = "--json" in argv
     try:
-        args = build_parser().parse_args(argv)
+        # only the command named first is built (--help, --version and mistakes get the whole parser)
+        first = argv[0] if argv and argv[0] in EXAMPLES and not {"-h", "--help"} & set(argv) else None
+        args = build_parser(first).parse_args(argv)
         result = args.func(args)
         if args.json:
             print(json.dumps(result, default=_jsonable))

@@ -31,7 +31,6 @@ import math
 import os
 import pkgutil
 import sys
-import traceback
 from functools import cache, lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -108,7 +107,7 @@ def source_files(spec: str) -> list[Path]:
     ``path.py[:callable]`` (what it reads while it runs is found by :func:`load_traced`)."""
     if is_file_spec(spec):
         return [Path(_split_spec(spec)[0]).resolve()]
-    return sorted(f.resolve() for d in __path__ for f in Path(d).glob("*.py"))
+    return sorted(f for d in __path__ for f in Path(d).resolve().glob("*.py"))
 
 
 def load_traced(spec: str) -> tuple[HybridSystem, list[Path]]:
@@ -236,6 +235,8 @@ def _call(fn, what: str):
 
 def _where(e: BaseException, path: Path) -> str:
     """``file:line: `` of the innermost frame of the traceback that lies in ``path``."""
+    import traceback
+
     target = str(path.resolve())
     line = None
     for frame in traceback.extract_tb(e.__traceback__):
