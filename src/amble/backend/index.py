@@ -10,8 +10,10 @@ importing SymPy. The index finds it from what the model is *made of* instead. It
 * amble's version and the sources that the library key covers (the C engine, the backend, the
   derivation and the modelling layer, :func:`amble.backend.cache.source_digest`), and the package
   root that maps the public names to them;
-* the compiler command and ``$AMBLE_CFLAGS`` (not the compiler's ``--version``: running it is
-  the price of a subprocess; a compiler upgraded in place keeps serving the library it built).
+* ``$CC`` and ``$AMBLE_CFLAGS`` (not the compiler found on the ``PATH`` nor its ``--version``:
+  finding and running it is the price of a subprocess; a compiler upgraded in place, or another
+  found first on the ``PATH``, keeps serving the library the previous one built, which computes
+  the same model).
 
 Parameter values (``--set``) do not enter: they are run-time inputs of every library. An entry
 holds the library key of the system (:func:`~amble.backend.cache.structure_key`), the SHA-256 of
@@ -59,11 +61,7 @@ def index_key(spec: str, sources: Sequence[Path]) -> str:
     h = hashlib.sha256(f"amble-index\0{FORMAT}\0{__version__}\0{spec}\0".encode())
     h.update(cache.source_digest().encode())
     h.update(_ROOT_INIT.read_bytes())
-    try:
-        cc = cache.compiler()
-    except AmbleError:
-        cc = ""
-    h.update(f"\0{cc}\0{os.environ.get('AMBLE_CFLAGS', '-O2')}\0".encode())
+    h.update(f"\0{os.environ.get('CC', '')}\0{os.environ.get('AMBLE_CFLAGS', '-O2')}\0".encode())
     for f in sources:
         h.update(f"{f}\0".encode())
         h.update(Path(f).read_bytes())

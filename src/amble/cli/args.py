@@ -8,7 +8,6 @@ import argparse
 import functools
 import math
 import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -104,6 +103,8 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
             open(p, "ab").close()  # opening to append changes nothing
         except OSError as e:
             raise OutputError(f"{what}: cannot write {path!r} ({e.strerror or e})") from None
+    import tempfile  # here, not at import: a command without output files never needs it
+
     try:
         fd, probe = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".probe", dir=parent)
         os.close(fd)
