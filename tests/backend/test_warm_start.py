@@ -174,12 +174,13 @@ def test_models_load_returns_independent_systems():
     assert structure_key(load("compass-gait")) == key != structure_key(a)
 
 
-def test_warm_limit_cycle_imports_no_sympy(tmp_path):
-    """The command's run in a child, twice: the second finds the compiled model in the index and
+def test_warm_limit_cycle_imports_no_sympy():
+    """The commands in a child, twice: the second child finds the compiled model in the index,
     imports neither SymPy nor SciPy, and prints the fixed point the symbolic model gives."""
-    code = ("import json, sys; from amble.cli import main; rc = main(['limit-cycle', 'compass-gait', '--json']); "
-            "print(json.dumps([m for m in ('sympy', 'scipy', 'matplotlib', 'dask') if m in sys.modules]), "
-            "file=sys.stderr); sys.exit(rc)")
+    code = ("import json, sys; from amble.cli import main; "
+            "rc = main(['limit-cycle', 'compass-gait', '--json']) or main(['simulate', 'compass-gait', '--steps', "
+            "'3', '--json']); print(json.dumps([m for m in ('sympy', 'scipy', 'matplotlib', 'dask') "
+            "if m in sys.modules]), file=sys.stderr); sys.exit(rc)")
     # the tests' own cache (tests/conftest.py): usually warm already, primed by the first run if not
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "AMBLE_WARM_START": "1"}
     runs = [subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
@@ -187,10 +188,23 @@ def test_warm_limit_cycle_imports_no_sympy(tmp_path):
     for r in runs:
         assert r.returncode == 0, r.stderr
     assert json.loads(runs[1].stderr.strip().splitlines()[-1]) == []
+    from amble import simulate
     from amble.analysis.poincare import find_fixed_point
     from amble.models import load
 
     truth = find_fixed_point(load("compass-gait"))
-    got = json.loads(runs[1].stdout)
-    assert max(abs(u - v) for u, v in zip(got["fixed_point"], truth.fixed_point)) < 1e-9
-    assert got["multiplier_moduli"] == pytest.approx([abs(m) for m in truth.multipliers], abs=1e-9)
+    cycle, walk = (json.loads(line) for line in runs[1].stdout.splitlines())
+    assert max(abs(u - v) for u, v in zip(cycle["fixed_point"], truth.fixed_point)) < 1e-9
+    assert cycle["multiplier_moduli"] == pytest.approx([abs(m) for m in truth.multipliers], abs=1e-9)
+    assert walk["final_post_impact_state"] == pytest.approx(
+        simulate(load("compass-gait"), steps=3).final_post_impact_state.tolist(), abs=1e-12)
+
+
+def test_a_parameter_outside_its_domain_is_refused_on_the_warm_path(capsys):
+    from amble.cli.main import main
+
+    assert main(["limit-cycle", "compass-gait"]) == 0  # primes the index
+    capsys.readouterr()
+    assert isinstance(load_model("compass-gait", compiled=True, derivatives=True), CompiledSystem)
+    assert main(["limit-cycle", "compass-gait", "--set", "m=-1"]) == 2
+    assert capsys.readouterr().err.strip() == "amble: error: parameter 'm' = -1 is outside its domain (0, ∞)"
