@@ -10,7 +10,8 @@ SciPy or Matplotlib, so a command that finds its compiled model in the cache sta
 
 from __future__ import annotations
 
-import importlib
+import importlib as _importlib
+import sys as _sys
 from typing import TYPE_CHECKING, Any
 
 from .version import __version__  # noqa: F401  (amble.__version__)
@@ -38,11 +39,15 @@ _WHERE: dict[str, str] = {
 __all__ = sorted(_WHERE, key=lambda n: (not n.isupper(), n))
 
 
+if "IPython" in _sys.modules:  # in a notebook, ``import amble`` registers the rich display, as before
+    _importlib.import_module(".viz.notebook", __name__).register()
+
+
 def __getattr__(name: str) -> Any:
     where = _WHERE.get(name)
     if where is None:
         raise AttributeError(f"module 'amble' has no attribute {name!r}")
-    value = getattr(importlib.import_module(where, __name__), name)
+    value = getattr(_importlib.import_module(where, __name__), name)
     globals()[name] = value  # once loaded, an ordinary attribute
     return value
 
