@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ModelError, ParameterError
+from ..errors import AmbleError, ModelError, ParameterError
 from ..modelling.domain import Domain
 
 if TYPE_CHECKING:
@@ -180,7 +180,11 @@ class CompiledSystem:
 
     def __setstate__(self, state: tuple) -> None:
         self._state = state
-        self._open(*state)
+        info, libraries, loader = state
+        try:
+            self._open(info, libraries, loader)
+        except (AmbleError, OSError):  # a worker on another machine: no such library there; build it
+            self._open(info, {}, loader)
 
     def __repr__(self) -> str:
         return f"CompiledSystem({self.name!r}, modes={self.mode_names})"
