@@ -15,19 +15,21 @@ import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import ConvergenceError, StateError
-from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, walk_many
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
 from .section import Section
 from .sweep_runner import compiled, point_key, run_sweep
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 #: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
 BASIN_LABELS = ("converged", "fell", "not converged", "failed")

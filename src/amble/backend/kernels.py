@@ -12,14 +12,16 @@ from __future__ import annotations
 import copy
 import ctypes
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import CompileError, ModelError, StateError
-from ..modelling.hybrid import HybridSystem
 from . import abi, cache
 from .cache import cache_dir, structure_key
+
+if TYPE_CHECKING:  # loading a cached library imports no SymPy
+    from ..modelling.hybrid import HybridSystem
 
 __all__ = ["Kernels", "build", "cache_dir", "structure_key"]
 
@@ -36,7 +38,17 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
     ``derivatives``: also the derivative kernels (flow and reset Jacobians, guard gradients) that
     sensitivity runs, exact return-map Jacobians and the implicit integrator need. They are
     several times longer than the rest, so a library is built with them only when asked; one that
-    has them serves plain runs too, and is preferred when it is at hand."""
+    has them serves plain runs too, and is preferred when it is at hand.
+
+    A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
+    found by the warm-start index) is served those; without the ones asked for, its full system
+    is built."""
+    carried = getattr(type(system), "compiled_kernels", None)
+    if carried is not None:
+        k = carried(system, derivatives)
+        if k is not None:
+            return k
+        system = system.full()
     plain = cache.structure_key(system)
     full = cache.derivatives_key(plain)
     k = _LOADED.get(full) or (None if derivatives else _LOADED.get(plain))

@@ -12,16 +12,18 @@ import numbers
 import operator
 from collections.abc import Mapping, Sequence
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.abi import CODE, CTX
 from ..backend.kernels import Kernels, build
 from ..errors import ParameterError, StateError
-from ..modelling.hybrid import HybridSystem
 from .engine import RECORD_BUDGET, Options, Run, run
 from .trajectory import Event, Trajectory
+
+if TYPE_CHECKING:
+    from ..modelling.hybrid import HybridSystem
 
 
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
