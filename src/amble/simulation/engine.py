@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME
+from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
 from ..backend.kernels import Kernels
 from ..errors import StateError
 
@@ -219,18 +219,21 @@ _AT_EVENT = (CODE["STEPS_DONE"], CODE["TERMINAL"], CODE["MAX_EVENTS"])
 
 def _sensitivity_buffer(k: Kernels, nx0: int, params: bool) -> np.ndarray:
     """``S = [I 0]`` (the initial state's own columns), ``dτ = 0`` and the numbers of state and
-    parameter columns carried, laid out as sensitivity.h reads it."""
-    sens = np.zeros((k.nx_max + 1) * k.sc + 2)
-    S = sens[: k.nx_max * k.sc].reshape(k.nx_max, k.sc)
+    parameter columns carried, laid out by :func:`amble.backend.abi.sens_layout`."""
+    lay = sens_layout(k.nx_max, k.sc)
+    sens = np.zeros(lay["SIZE"])
+    S = sens[lay["S"] : lay["S"] + k.nx_max * k.sc].reshape(k.nx_max, k.sc)
     S[np.arange(nx0), np.arange(nx0)] = 1.0
-    sens[-2], sens[-1] = nx0, len(k.meta["params"]) if params else 0
+    sens[lay["NCS"]], sens[lay["NCP"]] = nx0, len(k.meta["params"]) if params else 0
     return sens
 
 
 def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) -> Sensitivity:
-    nxm, sc, npar = k.nx_max, k.sc, int(sens[-1])
-    S = sens[: nxm * sc].reshape(nxm, sc)[: r.x.size]
-    tau = sens[nxm * sc : nxm * sc + sc]
+    nxm, sc = k.nx_max, k.sc
+    lay = sens_layout(nxm, sc)
+    npar = int(sens[lay["NCP"]])
+    S = sens[lay["S"] : lay["S"] + nxm * sc].reshape(nxm, sc)[: r.x.size]
+    tau = sens[lay["TAU"] : lay["TAU"] + sc]
     cols = np.r_[np.arange(nx0), nxm + np.arange(npar)]
     S, tau = S[:, cols], tau[cols]
     if r.code in _AT_EVENT:
