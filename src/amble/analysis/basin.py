@@ -88,8 +88,8 @@ def _embed(k: Any, p: np.ndarray, section: tuple | None, idx: Sequence[int], S: 
 
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
                 base: list[float], fixed: list[float], to_state: Callable | None, steps: int, check_every: int,
-                tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None
-                ) -> list[dict[str, Any]]:
+                tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None,
+                threads: int = 1) -> list[dict[str, Any]]:
     """One or more grid rows: walk each cell with the compiled run loop, no recording.
 
     ``to_state`` ``None``: cells are put on the section (``section``: transition, time, pre-impact
@@ -119,7 +119,7 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     # convergence checks run in C with the GIL released, so threads and workers scale with cores
     valid = [c for c in cells if c[4] is not None]
     walks = walk_many(k, p, mi, np.array([c[4] for c in valid]).reshape(len(valid), n), xs, steps=steps,
-                      check_every=check_every, tol=tol, opts=opts) if valid else None
+                      check_every=check_every, tol=tol, opts=opts, threads=threads) if valid else None
     result = {(c[0], c[2]): w for w, c in enumerate(valid)}
     out = []
     for i, a, j, b, _x, why in cells:
@@ -157,6 +157,7 @@ def basin(
     max_points: int | None = None,
     rtol: float = BASIN_TOL,
     atol: float = BASIN_TOL,
+    threads: int = 1,
 ) -> BasinResult:
     """Basin of attraction of the period-1 gait over two post-impact coordinates.
 
@@ -172,7 +173,10 @@ def basin(
     ``|x − x*|∞ < tol``, ``fell`` if a terminal/fall event ended it, ``not converged`` if it kept
     walking elsewhere (another attractor or too slow), ``failed`` for any other run status.
     One Dask task per ``rows_per_task`` grid rows. ``rtol``/``atol``: integrator tolerances
-    (looser than for fixed points: only the outcome category matters here).
+    (looser than for fixed points: only the outcome category matters here). ``threads``: each
+    task's walks share this many threads of its process (with ``scheduler='synchronous'``: this
+    process) — the compiled walks release the GIL and take cells one by one, so two threads on
+    two cores walk a map in about half the time; the result does not depend on it.
     """
     from .poincare import ReturnMap, find_fixed_point
 
@@ -182,6 +186,8 @@ def basin(
             raise StateError(f"unknown coordinate {nm!r}; known: {', '.join(snames)}")
     if len(set(x_names)) != 2:
         raise StateError(f"basin: two different coordinates are needed, got {', '.join(x_names)}")
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise StateError(f"threads must be an integer ≥ 1, got {threads!r}")
     if len(n) != 2 or min(n) < 1 or steps < 1 or check_every < 1 or rows_per_task < 1:
         raise StateError("need n = (na ≥ 1, nb ≥ 1), steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
     av = np.linspace(ranges[0][0], ranges[0][1], int(n[0]))
@@ -206,7 +212,7 @@ def basin(
 
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
-                to_state, steps, check_every, tol, rtol, atol, list(x_names), section)
+                to_state, steps, check_every, tol, rtol, atol, list(x_names), section, threads)
 
     res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
                     groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,

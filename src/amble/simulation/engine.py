@@ -248,17 +248,21 @@ def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) 
 
 
 def walk_many(k: Kernels, p: np.ndarray, mode: int, x0: np.ndarray, xref: np.ndarray, *, steps: int,
-              check_every: int, tol: float, opts: Options = Options()) -> dict[str, Any]:
+              check_every: int, tol: float, opts: Options = Options(), threads: int = 1) -> dict[str, Any]:
     """Walk every row of ``x0`` from t = 0 for up to ``steps`` footfalls in one compiled call (no
     recording, the GIL released): in runs of ``check_every`` footfalls, each started like
     :func:`run` from the previous one's final state, until ``max |x − xref| < tol``. Returns per
     walk ``code``, ``status`` (as :attr:`Run.status`), ``steps``, ``distance`` (NaN if no run
     completed) and the final ``x`` — what a loop over :func:`run` gives, without its Python cost
-    per walk (which kept two threads of basin cells at about 1.2× one)."""
+    per walk (which kept two threads of basin cells at about 1.2× one). ``threads``: walk the rows
+    on this many threads of this process, which share them row by row (results do not depend
+    on it)."""
     opt = opts._opt.copy()
     opt[_OP_TEND] = math.inf
-    out = k.walk_batch(mode, x0, p, opt, opts._iopt, xref, steps, check_every, tol)
-    out["status"] = [outcome(k, int(c), int(i)) for c, i in zip(out["code"], out["info"])]
+    out = k.walk_batch(mode, x0, p, opt, opts._iopt, xref, steps, check_every, tol, threads=threads)
+    ok = CODE["STEPS_DONE"]
+    done = outcome(k, ok, -1)
+    out["status"] = [done if c == ok else outcome(k, c, i) for c, i in zip(out["code"].tolist(), out["info"].tolist())]
     return out
 
 

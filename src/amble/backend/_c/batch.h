@@ -26,8 +26,14 @@ static void batch_ctx(double *ctx, int mode, const double *x) {
  * option layouts of the runs (end time, tolerances, caps; capacities are ignored: nothing is
  * recorded). Per walk: the status of its last run (ST_STEPS_DONE if all runs completed), the
  * index of the transition that ended it (or -1), the footfalls taken, the last distance (NaN if
- * no run completed) and the final state (NaN-padded to NXMAX). */
-void amble_walk_batch(int64_t n, int mode, const double *x0, const double *p, const double *opt,
+ * no run completed) and the final state (NaN-padded to NXMAX).
+ *
+ * next: NULL (walk rows 0 … n-1 in order), or a counter shared by several threads calling this
+ * on the same rows at once: each takes the next unwalked row with an atomic increment, so the
+ * threads share the walks one by one, however unequal their lengths (a walk that falls at once
+ * and one that walks all its steps differ a hundredfold; blocks fixed in advance leave one
+ * thread working alone at the end). Each row is written by the one thread that took it. */
+void amble_walk_batch(int64_t n, int64_t *next, int mode, const double *x0, const double *p, const double *opt,
                       const int64_t *iopt_in, const double *xref, int64_t steps, int64_t check_every, double tol,
                       int *code, int *info, int64_t *done_steps, double *dist, double *x_out) {
     int64_t iopt[IO_YIELDN + 1];
@@ -37,8 +43,10 @@ void amble_walk_batch(int64_t n, int mode, const double *x0, const double *p, co
     if (check_every < 1) check_every = 1;
     const int nx = MODE_NX[mode];
     double ctx[CX_X + NXMAX];
-    int64_t zero = 0;
-    for (int64_t r = 0; r < n; ++r) {
+    int64_t zero = 0, own = 0;
+    for (;;) {
+        const int64_t r = next ? __atomic_fetch_add(next, 1, __ATOMIC_RELAXED) : own++;
+        if (r >= n) break;
         double x[NXMAX];
         for (int i = 0; i < NXMAX; ++i) x[i] = i < nx ? x0[r * NXMAX + i] : NAN;
         int64_t walked = 0;
