@@ -101,20 +101,35 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     xs = np.asarray(fixed, float)
     b0 = np.asarray(base, float)
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
-    if to_state is None:
-        idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
-        to_state = _embed(k, p, None if section is None else tuple(section[:3]), idx,
-                          [] if section is None else section[3])
     cells = []  # (i, a, j, b, state or None, reason it has none)
-    for i, a in rows:
-        for j, b in enumerate(b_values):
-            try:
-                x = np.asarray(to_state(a, b, b0), float)
-            except ConvergenceError:  # no state of the section has these two coordinates here
+    if to_state is None and section is not None:
+        # the default embedding on the section: every cell's Newton solve in one compiled call
+        # (the GIL released, shared by the threads), not one Python iteration per cell
+        idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
+        grid = [(i, a, j, b) for i, a in rows for j, b in enumerate(b_values)]
+        raw = np.tile(b0, (len(grid), 1))
+        raw[:, idx[0]] = [g[1] for g in grid]
+        raw[:, idx[1]] = [g[3] for g in grid]
+        sec = Section(k, p, *section[:3])
+        for (i, a, j, b), x in zip(grid, sec.project_many(raw, section[3], threads=threads)):
+            if x is None:  # no state of the section has these two coordinates here
                 cells.append((i, a, j, b, None, "off the section"))
                 continue
             ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
             cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
+    else:
+        if to_state is None:
+            idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
+            to_state = _embed(k, p, None, idx, [])
+        for i, a in rows:
+            for j, b in enumerate(b_values):
+                try:
+                    x = np.asarray(to_state(a, b, b0), float)
+                except ConvergenceError:  # no state of the section has these two coordinates here
+                    cells.append((i, a, j, b, None, "off the section"))
+                    continue
+                ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
+                cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
     # every valid cell of the task in one compiled call (amble_walk_batch): the walks and their
     # convergence checks run in C with the GIL released, so threads and workers scale with cores
     valid = [c for c in cells if c[4] is not None]

@@ -113,6 +113,12 @@ class Kernels:
         lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 5 + \
             [ctypes.c_int64, ctypes.c_int64, ctypes.c_double] + [ctypes.c_void_p] * 5
         self._walk_batch = lib.amble_walk_batch
+        lib.amble_project_batch.restype = None
+        lib.amble_project_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int,
+                                            ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int,
+                                            ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_int,
+                                            ctypes.c_void_p, ctypes.c_void_p]
+        self._project_batch = lib.amble_project_batch
 
     # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
     def mode_index(self, mode: str | int) -> int:
@@ -262,6 +268,38 @@ class Kernels:
             for w in workers:
                 w.join()
         return out
+
+    def project_batch(self, mode: int, transition: int, row: int, t: float, pre: np.ndarray, S: np.ndarray,
+                      x: np.ndarray, p: np.ndarray, tol: float, max_iter: int, threads: int = 1
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """Put every row of ``x`` (states of the transition's target mode) on its post-impact
+        section in one compiled call, by the Newton iteration of
+        :meth:`amble.analysis.section.Section.project` from the pre-impact state ``pre`` (guard
+        ``row`` of ``mode``, time ``t``, section coordinates ``S``). Returns the post-impact states
+        (NaN-padded to ``nx_max``) and per row whether the iteration decided it (``False``: a
+        reset that failed, a rank-deficient step, no convergence — left to the full iteration).
+        ``threads`` as for :meth:`walk_batch`. Needs the derivative kernels."""
+        self._need_derivatives()
+        x = np.asarray(x, dtype=float)
+        n = x.shape[0]
+        xs = np.full((n, self.nx_max), np.nan)
+        xs[:, : x.shape[1]] = x
+        pre = np.ascontiguousarray(pre, dtype=float)
+        S = np.ascontiguousarray(S, dtype=np.int64)
+        p = np.ascontiguousarray(p, dtype=float)
+        y, ok = np.zeros((n, self.nx_max)), np.zeros(n, dtype=np.int32)
+        threads = max(1, min(int(threads), n))
+        counter = np.zeros(1, dtype=np.int64)
+        args = (n, counter.ctypes.data if threads > 1 else None, int(mode), int(transition), int(row), float(t),
+                pre.ctypes.data, S.ctypes.data, len(S), xs.ctypes.data, p.ctypes.data, float(tol), int(max_iter),
+                y.ctypes.data, ok.ctypes.data)
+        workers = [threading.Thread(target=self._project_batch, args=args) for _ in range(threads - 1)]
+        for w in workers:
+            w.start()
+        self._project_batch(*args)
+        for w in workers:
+            w.join()
+        return y, ok.astype(bool)
 
     def energy_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         t, modes, x = _rows(t, modes, x, self.nx_max, self.n_modes)
