@@ -2,9 +2,10 @@
 
 Everything both languages must agree on is listed here once: the run status codes, the fields of
 the resumable context array ``ctx``, of the real and integer option arrays ``opt`` and ``iopt``,
-the layout of the sensitivity buffer, and the integer width of counters. The C header the engine includes is generated from these
-tables (:func:`c_header`), and a loaded library reports its layout back, which is compared with
-:data:`LAYOUT` at load — a stale library is refused instead of misread.
+the layout of the sensitivity buffer, and the integer width of counters. The C header the engine
+includes is generated from these tables (:func:`c_header`), and a loaded library reports its
+layout back, which is compared with :data:`LAYOUT` at load — a stale library is refused instead
+of misread.
 """
 
 from __future__ import annotations
@@ -119,8 +120,9 @@ LAYOUT = int(hashlib.sha256(_layout_text().encode()).hexdigest()[:15], 16)
 
 def c_header(layout: int | None = None) -> str:
     """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*``, ``SENS_*``
-    (offsets in terms of the unit's ``NXMAX`` and ``SC``) and ``AMBLE_LAYOUT`` (default :data:`LAYOUT`), written into every generated translation unit
-    before the engine is included. Integer arrays shared with NumPy int64 are ``int64_t``."""
+    (offsets in terms of the unit's ``NXMAX`` and ``SC``) and ``AMBLE_LAYOUT`` (default
+    :data:`LAYOUT`), written into every generated translation unit before the engine is included.
+    Integer arrays shared with NumPy int64 are ``int64_t``."""
     lines = ["/* Python <-> C interface, generated from amble/backend/abi.py; do not edit. */",
              "#include <stdint.h>"]
     lines += [f"#define ST_{name} {code}" for code, name, _ in STATUS]

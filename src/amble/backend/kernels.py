@@ -257,7 +257,8 @@ class Kernels:
         threads = min(threads, n)
         counter = np.zeros(1, dtype=np.int64)
         args = (n, addr(counter) if threads > 1 else None, mi, addr(xs), addr(p), addr(opt), addr(iopt), addr(xref),
-                int(steps), int(check_every), float(tol), *(addr(out[k]) for k in ("code", "info", "steps", "distance", "x")))
+                int(steps), int(check_every), float(tol),
+                *(addr(out[k]) for k in ("code", "info", "steps", "distance", "x")))
         if threads <= 1:
             self._walk_batch(*args)
         else:
