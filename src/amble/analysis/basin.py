@@ -115,7 +115,8 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
             if x is None:  # no state of the section has these two coordinates here
                 cells.append((i, a, j, b, None, "off the section"))
                 continue
-            ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
+            # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite
+            ok = x.shape == (n,) and math.isfinite(float(x.sum()))
             cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
     else:
         if to_state is None:
