@@ -134,7 +134,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (ev_k < 0) {
             if (sens) {
                 double y1[NXMAX];
-                if ((st = sens_advance(mode, p, sens_cols(sens), t, s.h, s.y_old, sens, y1))) { status = st; break; }
+                if ((st = sens_advance(mode, p, sens_cols(sens), t, s.h, s.y_old, sens + SENS_S, y1))) { status = st; break; }
             }
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }
