@@ -47,6 +47,8 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
     low = lambda i, j: ex[max(i, j) * (max(i, j) + 1) // 2 + min(i, j)]  # M[i, j] of the lower triangle
     nonzero = {(i, j) for i in range(n) for j in range(i) if low(i, j) != 0}
+    if not hoist.enabled:  # the code of before (benchmarks): a dense solve in the natural order
+        nonzero = {(i, j) for i in range(n) for j in range(i)}
     order = ldl_order(n, nonzero) if n <= UNROLL_MAX else list(range(n))
     known = constant_pivots(sp.Matrix(n, n, lambda i, j: low(order[i], order[j])), nm, hoist)
     ex = hoist(ex)
@@ -79,7 +81,8 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
     ``derivatives`` also the derivative kernels of sensitivity runs and of the implicit
     integrator (several times longer than the rest: built only when asked for).
     ``hoist_params=False`` recomputes parameter-only subexpressions at every use instead of once
-    per call (:mod:`amble.backend.hoist`; for benchmarks of what that saves)."""
+    per call (:mod:`amble.backend.hoist`) and solves with M as if it were dense, in the natural
+    order (:mod:`amble.backend.ldl`): for benchmarks of what those save."""
     params = list(system.parameters)
     modes = {name: ModeInfo(m, derive(m), i) for i, (name, m) in enumerate(system.modes.items())}
     points = system.point_names
