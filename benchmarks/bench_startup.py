@@ -4,7 +4,14 @@
   compiled before the limit cycle is found;
 * warm: the cache already holds the compiled model (one untimed priming run), so the run is
   interpreter start-up + imports + loading the shared library + the Newton search;
-* context: ``python -c "pass"`` (bare interpreter) and ``python -c "import amble"``.
+* the floor, measured in the same run and interleaved with the warm runs: ``python -c "pass"``
+  (bare interpreter) and ``python -c "import numpy"`` (the one import a compiled run cannot do
+  without), beside ``python -c "import amble"`` (which loads its names on first use);
+* whether the warm run imported SymPy (it should not: the compiled model is found by the
+  warm-start index, :mod:`amble.backend.index`).
+
+Byte code of amble's sources is compiled before timing (``compileall``), as an installed package
+has it: with ``PYTHONDONTWRITEBYTECODE`` set, every run would otherwise recompile ~60 modules.
 
 The console script installed next to the running interpreter is executed directly (not through
 a version-manager shim), so the timings are what a user's ``amble`` command costs. If the warm
@@ -14,6 +21,8 @@ largest contributors are listed.
 
 from __future__ import annotations
 
+import compileall
+import json
 import re
 import shutil
 import subprocess
@@ -91,6 +100,18 @@ def _cprofile(cmd_args: list[str], env: dict[str, str], top: int = 25) -> str:
     return re.sub(r"\S*/site-packages/", "", text)
 
 
+_SYMPY_CODE = ("import json, sys; from amble.cli import main; main(sys.argv[1:]); "
+               "print(json.dumps(sorted(m for m in ('sympy', 'scipy', 'matplotlib', 'dask') if m in sys.modules)), "
+               "file=sys.stderr)")
+
+
+def _heavy_imports(cmd_args: list[str], env: dict[str, str]) -> list[str]:
+    """The heavy libraries a warm run imports (SymPy, SciPy, Matplotlib, Dask)."""
+    proc = subprocess.run([sys.executable, "-c", _SYMPY_CODE, *cmd_args], env=env, capture_output=True, text=True)
+    lines = proc.stderr.strip().splitlines()
+    return json.loads(lines[-1]) if lines else ["?"]
+
+
 def _n_libraries(cache: str) -> int:
     return sum(1 for _ in Path(cache).glob("*.so"))
 
@@ -119,6 +140,9 @@ def run(quick: bool = False) -> Section:
     """Time cold and warm starts (medians of ≥ 5 runs) and return the section."""
     reps = 5
     exe = amble_executable()
+    import amble  # the package the children import (same environment): its byte code, as installed
+
+    compileall.compile_dir(str(Path(amble.__file__).parent), quiet=1)
     cmd = [*exe, *COMMAND]
     print("startup: cold runs ...", flush=True)
     cold = []
@@ -133,10 +157,17 @@ def run(quick: bool = False) -> Section:
     try:
         env = child_env(warm_dir)
         _wall(cmd, env)  # prime the cache
-        warm, rebuilt = _warm_runs(cmd, env, warm_dir, reps)
-        bare = [_wall([sys.executable, "-c", "pass"], env) for _ in range(reps)]
-        imp = [_wall([sys.executable, "-c", "import amble"], env) for _ in range(reps)]
-        s_cold, s_warm, s_bare, s_imp = (Stats.of(v) for v in (cold, warm, bare, imp))
+        # interleaved, so that the warm runs and their floor see the same load of the machine
+        warm, bare, nump, imp, rebuilt = [], [], [], [], 0
+        for _ in range(reps):
+            w, r = _warm_runs(cmd, env, warm_dir, 1)
+            warm += w
+            rebuilt += r
+            bare.append(_wall([sys.executable, "-c", "pass"], env))
+            nump.append(_wall([sys.executable, "-c", "import numpy"], env))
+            imp.append(_wall([sys.executable, "-c", "import amble"], env))
+        heavy = _heavy_imports(list(COMMAND), env)
+        s_cold, s_warm, s_bare, s_np, s_imp = (Stats.of(v) for v in (cold, warm, bare, nump, imp))
         profile_md: list[str] = []
         if s_warm.median > GOAL_WARM_S:
             print("startup: warm start misses its goal; profiling ...", flush=True)
@@ -157,8 +188,10 @@ def run(quick: bool = False) -> Section:
         [f"`{shown}`, cold cache", *cells(s_cold), f"≤ {GOAL_COLD_S:g}"],
         [f"`{shown}`, warm cache", *cells(s_warm), f"≤ {GOAL_WARM_S:g}"],
         ['`python -c "import amble"`', *cells(s_imp), ""],
+        ['`python -c "import numpy"` (floor)', *cells(s_np), ""],
         ['`python -c "pass"` (bare interpreter)', *cells(s_bare), ""],
     ]
+    above = s_warm.median - s_np.median
     md = [
         f"Fresh process per run, wall time, median and min of {reps} runs. Cold: a new empty "
         "`AMBLE_CACHE_DIR` every run (derive + generate + compile the model, then find the limit cycle); "
@@ -167,6 +200,10 @@ def run(quick: bool = False) -> Section:
            "discarded and repeated." if rebuilt else ""),
         "",
         table(["command", "median s", "min s", "goal s"], rows),
+        "",
+        f"The warm run takes {above:.3f} s above the `import numpy` floor of the same run "
+        f"({s_warm.median / s_np.median:.2f}× it); heavy libraries it imported: "
+        f"{', '.join(heavy) if heavy else 'none (no SymPy, SciPy, Matplotlib or Dask)'}.",
         *profile_md,
     ]
     goals = [
@@ -175,5 +212,8 @@ def run(quick: bool = False) -> Section:
         Goal("`amble limit-cycle compass-gait`, warm cache", f"≤ {GOAL_WARM_S:g} s",
              f"{s_warm.median:.2f} s (min {s_warm.min:.2f})", s_warm.median <= GOAL_WARM_S),
     ]
-    data = {"cold": cold, "warm": warm, "import": imp, "bare": bare, "executable": exe}
+    goals.append(Goal("warm `amble limit-cycle compass-gait` imports no SymPy", "none",
+                      ", ".join(heavy) or "none", "sympy" not in heavy))
+    data = {"cold": cold, "warm": warm, "import": imp, "numpy": nump, "bare": bare, "heavy_imports": heavy,
+            "executable": exe}
     return Section("Start-up: command line", "\n".join(md), goals, data)

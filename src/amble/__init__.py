@@ -2,40 +2,89 @@
 
 Write coordinates, positions, masses and energies; amble derives the equations of motion and
 impact maps, compiles them, simulates with exact events, and finds limit cycles.
+
+The names below are loaded on first use (:pep:`562`): ``import amble`` alone costs no SymPy,
+SciPy or Matplotlib, so a command that finds its compiled model in the cache starts fast.
+``from amble import Model`` works as usual.
 """
 
-from .derivation.equations import Equations, derive
-from .derivation.resting import contact_force, unilateral_contact
-from .errors import (
-    AmbleError,
-    CompileError,
-    ConvergenceError,
-    ModelError,
-    OutputError,
-    ParameterError,
-    SchedulerError,
-    SimulationError,
-    StateError,
-)
-from .modelling.contact import RoundFoot, rolling_centre, round_foot
-from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval
-from .modelling.geometry import R3, R, Rx, Ry, Rz, t, vector
-from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
-from .modelling.model import Model
-from .modelling.sampled import sample_and_hold
-from .modelling.walker import Walker, distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
-from .simulation.engine import Options
-from .simulation.simulate import simulate
-from .simulation.trajectory import Event, Trajectory
-from .version import __version__  # noqa: F401  (amble.__version__)
-from .viz import animate, plot_limit_cycle, plot_trajectory
+from __future__ import annotations
 
-__all__ = [
-    "NONNEGATIVE", "POSITIVE", "R", "R3", "Rx", "Ry", "Rz", "AmbleError", "CompileError", "ConvergenceError",
-    "Domain", "Equations",
-    "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
-    "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
-    "contact_force", "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
-    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate", "t",
-    "unilateral_contact", "vector", "walker",
-]
+import importlib as _importlib
+import sys as _sys
+from typing import TYPE_CHECKING, Any
+
+from .version import __version__  # noqa: F401  (amble.__version__)
+
+#: public name → module (relative to this package) that defines it
+_WHERE: dict[str, str] = {
+    **dict.fromkeys(("Equations", "derive"), ".derivation.equations"),
+    **dict.fromkeys(("contact_force", "unilateral_contact"), ".derivation.resting"),
+    **dict.fromkeys(("AmbleError", "CompileError", "ConvergenceError", "ModelError", "OutputError", "ParameterError",
+                     "SchedulerError", "SimulationError", "StateError"), ".errors"),
+    **dict.fromkeys(("RoundFoot", "rolling_centre", "round_foot"), ".modelling.contact"),
+    **dict.fromkeys(("NONNEGATIVE", "POSITIVE", "Domain", "interval"), ".modelling.domain"),
+    **dict.fromkeys(("R3", "R", "Rx", "Ry", "Rz", "t", "vector"), ".modelling.geometry"),
+    **dict.fromkeys(("Explicit", "Guard", "HybridSystem", "Impact", "Lock"), ".modelling.hybrid"),
+    "Model": ".modelling.model",
+    "sample_and_hold": ".modelling.sampled",
+    **dict.fromkeys(("Walker", "distance_along_slope", "heel_strike", "height_above_slope", "joint_lock", "walker"),
+                    ".modelling.walker"),
+    "Options": ".simulation.engine",
+    "simulate": ".simulation.simulate",
+    **dict.fromkeys(("Event", "Trajectory"), ".simulation.trajectory"),
+    **dict.fromkeys(("animate", "plot_limit_cycle", "plot_trajectory"), ".viz"),
+}
+
+__all__ = sorted(_WHERE, key=lambda n: (not n.isupper(), n))
+
+
+if "IPython" in _sys.modules:  # in a notebook, ``import amble`` registers the rich display, as before
+    _importlib.import_module(".viz.notebook", __name__).register()
+
+
+def __getattr__(name: str) -> Any:
+    where = _WHERE.get(name)
+    if where is None:
+        raise AttributeError(f"module 'amble' has no attribute {name!r}")
+    value = getattr(_importlib.import_module(where, __name__), name)
+    globals()[name] = value  # once loaded, an ordinary attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_WHERE))
+
+
+if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
+    from .derivation.equations import Equations, derive  # noqa: F401
+    from .derivation.resting import contact_force, unilateral_contact  # noqa: F401
+    from .errors import (  # noqa: F401
+        AmbleError,
+        CompileError,
+        ConvergenceError,
+        ModelError,
+        OutputError,
+        ParameterError,
+        SchedulerError,
+        SimulationError,
+        StateError,
+    )
+    from .modelling.contact import RoundFoot, rolling_centre, round_foot  # noqa: F401
+    from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval  # noqa: F401
+    from .modelling.geometry import R3, R, Rx, Ry, Rz, t, vector  # noqa: F401
+    from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock  # noqa: F401
+    from .modelling.model import Model  # noqa: F401
+    from .modelling.sampled import sample_and_hold  # noqa: F401
+    from .modelling.walker import (  # noqa: F401
+        Walker,
+        distance_along_slope,
+        heel_strike,
+        height_above_slope,
+        joint_lock,
+        walker,
+    )
+    from .simulation.engine import Options  # noqa: F401
+    from .simulation.simulate import simulate  # noqa: F401
+    from .simulation.trajectory import Event, Trajectory  # noqa: F401
+    from .viz import animate, plot_limit_cycle, plot_trajectory  # noqa: F401

@@ -100,3 +100,36 @@ def test_analysis_knows_no_coordinate_or_parameter_names():
         assert not re.search(r"""["'](slope|stance|swing)(_dot)?["']""", code), f.name
     assert not hasattr(__import__("amble.analysis.bifurcation", fromlist=["x"]), "on_section")
     assert not hasattr(__import__("amble.analysis.basin", fromlist=["x"]), "SetCoordinates")
+
+
+def test_project_many_solves_the_section_equations_as_project_does():
+    """The compiled Newton iteration over many states: each result lies on the section (its
+    guard at the pre-impact state is zero, its coordinates S are the given ones) and is the
+    state the Python iteration finds, to the projection tolerance (None exactly where project
+    raises)."""
+    import numpy as np
+
+    from amble.analysis.poincare import ReturnMap, find_fixed_point
+    from amble.analysis.section import Section
+    from amble.errors import ConvergenceError
+    from amble.models import load
+
+    system = load("compass-gait")
+    xs = find_fixed_point(system).fixed_point
+    sec = Section.of(ReturnMap(system, None, rtol=1e-8, atol=1e-8), xs)
+    S = sec.coordinates(prefer=[0, 2])
+    rng = np.random.default_rng(5)
+    X = np.tile(xs, (30, 1))
+    X[:, 0] += rng.uniform(-0.2, 0.2, 30)
+    X[:, 2] += rng.uniform(-0.8, 0.8, 30)
+    many = sec.project_many(X, S, threads=2)
+    for x, y in zip(X, many):
+        try:
+            ref = sec.project(x, S)
+        except ConvergenceError:
+            assert y is None
+            continue
+        assert y is not None
+        np.testing.assert_allclose(y[S], x[S], atol=1e-11)
+        np.testing.assert_allclose(y, ref, atol=1e-10)
+    assert sum(y is not None for y in many) >= 25

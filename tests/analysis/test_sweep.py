@@ -28,6 +28,7 @@ from amble.analysis.sweep import (
     sweep_fixed_points_2d,
 )
 from amble.cli.main import main
+from amble.errors import StateError
 
 SYNC = {"scheduler": "synchronous", "progress": False}
 
@@ -144,6 +145,21 @@ def test_basin_small_grid(compass, tmp_path):
     again = basin(compass, ("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)),
                   (3, 3), steps=40, out=tmp_path / "basin.csv", **SYNC)
     assert again.computed == 0 and np.array_equal(again.outcome, res.outcome)
+
+
+def test_basin_on_two_threads_equals_one_cell_by_cell(compass):
+    """Cells walked by two threads sharing each task's walks: every cell's outcome, steps and
+    distance are those of one thread, exactly (a cell is walked whole by one thread)."""
+    xs = find_fixed_point(compass).fixed_point
+    grid = (("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)), (3, 5))
+    one = basin(compass, *grid, steps=30, **SYNC)
+    two = basin(compass, *grid, steps=30, threads=2, **SYNC)
+    assert len({int(v) for v in one.outcome.ravel()}) >= 2  # a map with more than one outcome
+    np.testing.assert_array_equal(two.outcome, one.outcome)
+    np.testing.assert_array_equal(two.steps, one.steps)
+    np.testing.assert_array_equal(two.distance, one.distance)
+    with pytest.raises(StateError, match="threads"):
+        basin(compass, *grid, steps=30, threads=0, **SYNC)
 
 
 def test_plots(compass, tmp_path):

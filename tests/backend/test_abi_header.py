@@ -27,7 +27,7 @@ def test_header_equals_the_tables():
 def test_engine_sources_define_no_interface_codes():
     for f in cache.C_DIR.iterdir():
         text = f.read_text()
-        assert not re.search(r"^\s*#\s*define\s+((ST|CX|OP|IO)_\w+|AMBLE_LAYOUT)", text, re.M), f.name
+        assert not re.search(r"^\s*#\s*define\s+((ST|CX|OP|IO|SENS)_\w+|AMBLE_LAYOUT)", text, re.M), f.name
 
 
 def test_generated_unit_carries_the_header(compass):
@@ -46,3 +46,15 @@ def test_library_with_another_layout_is_refused(compass, monkeypatch):
     monkeypatch.setattr(abi, "LAYOUT", abi.LAYOUT + 1)
     with pytest.raises(CompileError, match="clear the cache"):
         Kernels(k.path, k.meta)
+
+
+def test_sensitivity_layout_is_the_tables():
+    """The C offsets, evaluated for a library's NXMAX and SC, are those Python lays out: the
+    state block, then one row of dτ, then the two column counts, then the end of the buffer."""
+    text = abi.c_header()
+    exprs = {m[1]: m[2] for m in re.finditer(r"^#define SENS_(\w+) (.+)$", text, re.M)}
+    for nxm, sc in ((4, 4), (4, 7), (14, 20)):
+        c = {name: eval(e, {"NXMAX": nxm, "SC": sc}) for name, e in exprs.items()}  # C arithmetic of ints
+        assert c == abi.sens_layout(nxm, sc)
+        assert c == {"S": 0, "TAU": nxm * sc, "NCS": nxm * sc + sc, "NCP": nxm * sc + sc + 1,
+                     "SIZE": (nxm + 1) * sc + 2}

@@ -74,3 +74,28 @@ def test_batch_refuses_states_of_the_wrong_length(walker):
     opts = Options()
     with pytest.raises(StateError):
         k.walk_batch(0, np.zeros((3, 5)), p, _opt(opts), opts._iopt, xs, 5, 5, 1e-6)
+
+
+def test_threads_share_the_walks_and_change_none(walker):
+    """Two and three threads taking rows from one counter give every walk exactly as one thread
+    does (each row is walked whole by whichever thread takes it), with walks of very unequal
+    length (some fall at once, some walk all their steps)."""
+    system, k, p, xs = walker
+    opts = Options(rtol=1e-8, atol=1e-8, max_step_time=system.max_step_time)
+    rng = np.random.default_rng(7)
+    x0 = xs + rng.normal(0, [0.08, 0.08, 0.5, 0.5], size=(40, 4))
+    x0[:, 1] = 2 * p[k.meta["params"].index("slope")] - x0[:, 0]
+    one = k.walk_batch(0, x0, p, _opt(opts), opts._iopt, xs, 25, 5, 1e-4)
+    assert len(set(one["steps"].tolist())) > 2  # unequal walks
+    for threads in (2, 3):
+        many = k.walk_batch(0, x0, p, _opt(opts), opts._iopt, xs, 25, 5, 1e-4, threads=threads)
+        for f in ("code", "info", "steps", "distance", "x"):
+            np.testing.assert_array_equal(many[f], one[f])
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, True, "2"])
+def test_threads_must_be_a_positive_integer(walker, bad):
+    system, k, p, xs = walker
+    opts = Options()
+    with pytest.raises(StateError, match="threads"):
+        k.walk_batch(0, xs[None, :], p, _opt(opts), opts._iopt, xs, 5, 5, 1e-6, threads=bad)

@@ -79,13 +79,30 @@ def test_posture_has_the_models_coordinate_count(capsys, tmp_path):
     assert code == 2 and "posture must be 5 finite numbers" in err and "Traceback" not in err
 
 
-@pytest.mark.slow
 def test_rabbit_at_0_8_m_per_s_from_the_command_line(capfd, tmp_path):
-    """The issue's command on the library RABBIT (default start: a step of its HZD controller,
-    which compiles once): 0.8 m/s, feasible, the parameters for its controller in gait.json."""
+    """The issue's command on the library RABBIT with its naive default start (standing still)
+    and, by default, its own virtual constraints: 0.8 m/s, feasible, the parameters for its
+    controller in gait.json."""
     path = tmp_path / "gait.json"
-    code, out, err = run(capfd, "optimize-gait", "rabbit", "--speed", "0.8", "--hzd", "--out", str(path), "--quiet")
+    code, out, err = run(capfd, "optimize-gait", "rabbit", "--speed", "0.8", "--out", str(path), "--quiet")
     assert code == 0, err
     d = json.loads(path.read_text())
     assert d["speed"] == pytest.approx(0.8, rel=1e-9) and d["max_violation"] <= 1e-8
     assert set(d["bezier"]["params"]) >= {"alpha_0_0", "alpha_3_5", "phase_start", "phase_end"}
+
+
+def test_two_step_gait_from_the_command_line(capsys, tmp_path):
+    """``--steps 2`` on the passive compass gait at 4.6° (past its first period doubling): both
+    steps in gait.json, the pair the period-2 orbit of the exact return map; a bad count exits 2."""
+    path = tmp_path / "gait.json"
+    code, out, err = run(capsys, "optimize-gait", "compass-gait", "--set", "slope=0.0803", "--steps", "2",
+                         "--nodes", "20,60", "--quiet", "--out", str(path))
+    assert code == 0, err
+    assert "step 2:" in out
+    d = json.loads(path.read_text())
+    assert d["period"] == 2 and len(d["steps"]) == 2
+    lc = find_fixed_point(load("compass-gait"), d["fixed_point"], params={"slope": 0.0803}, period=2)
+    assert lc.period == 2
+    assert np.abs(np.asarray(lc.orbit[1]) - d["steps"][1]["fixed_point"]).max() <= 1e-6
+    code, _, err = run(capsys, "optimize-gait", "compass-gait", "--steps", "0")
+    assert code == 2 and "--steps" in err and "Traceback" not in err

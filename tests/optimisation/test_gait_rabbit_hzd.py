@@ -36,14 +36,17 @@ def _outputs_on_gait(system, gait):
     return np.array([np.concatenate([np.ravel(a) for a in f(*x)]) for x in mesh])
 
 
-def test_rabbit_hzd_gait_at_0_8_m_per_s_satisfies_the_models_virtual_constraints():
-    """Coarse mesh (cheap): the gait is feasible to 1e-8, walks at 0.8 m/s, and with the exported
+def test_rabbit_hzd_gait_at_0_8_m_per_s_from_standing_still_satisfies_the_models_virtual_constraints():
+    """Coarse mesh (cheap), from the default start of a model under feedback — standing still in
+    its posture, nothing moving: the gait is feasible to 1e-8, walks at 0.8 m/s, and with the exported
     ``alpha``/``phase_start``/``phase_end`` the model's own virtual constraints hold at the mesh
     points; the first two Bézier columns are the hybrid-invariant ones (Westervelt et al. 2007,
     Thm. 6.5: ``α₀`` of output i is ``α_M`` of the output it is relabelled to)."""
     s = rabbit.build()
-    g = optimize_gait(s, speed=SPEED, nodes=10, guess="interpolate", step_time=0.4, hzd=True)
+    g = optimize_gait(s, speed=SPEED, nodes=10)  # guess "stand" and hzd=True: the defaults for this model
+    assert g.solver["iterations_total"] > g.solver["iterations"]  # a feasibility solve came first
     assert g.max_violation <= 1e-8
+    assert all(r["max_violation"] <= 1e-8 for r in g.constraints.values())
     assert g.speed == pytest.approx(SPEED, rel=1e-9)
     assert g.constraints["contact"]["max_violation"] <= 1e-8
     assert np.abs(g.inputs).max() <= 150.0 + 1e-8
@@ -60,7 +63,7 @@ def test_rabbit_hzd_gait_at_0_8_m_per_s_satisfies_the_models_virtual_constraints
 
 @pytest.mark.slow
 def test_rabbit_hzd_gait_walks_in_closed_loop():
-    """Mesh 20 → 80 from the interpolated start: the model's compiled HZD controller with the
+    """Mesh 20 → 80 from standing still (the default start): the model's compiled HZD controller with the
     exported parameters walks the gait. The closed-loop state stays within 1e-4 of the collocated
     one, at the collocation points and along the step (the solution's Hermite interpolant);
     Newton on the closed-loop return map converges (residual ≤ 1e-8) within 1e-5 of the optimised
@@ -69,8 +72,9 @@ def test_rabbit_hzd_gait_walks_in_closed_loop():
     from amble.analysis.poincare import find_fixed_point
 
     s = rabbit.build()
-    g = optimize_gait(s, speed=SPEED, nodes=[20, 80], guess="interpolate", step_time=0.4, hzd=True)
+    g = optimize_gait(s, speed=SPEED, nodes=[20, 80], guess="stand", step_time=0.4)
     assert g.max_violation <= 1e-8
+    assert np.abs(g.states[:, g.state_names.index("torso")]).max() < 0.5
     P = g.bezier["params"]
     walk = simulate(s, g.fixed_point, params=P, steps=1, sample_dt=2e-4)
     ev = walk.step_events[0]
@@ -85,3 +89,13 @@ def test_rabbit_hzd_gait_walks_in_closed_loop():
     assert lc.residual <= 1e-8
     assert np.abs(lc.fixed_point - g.fixed_point).max() <= 1e-5
     assert np.abs(lc.multipliers).max() < 1.0
+
+
+def test_rabbit_hzd_gait_from_the_interpolated_start():
+    """The interpolated start (posture to its relabelling) still gives a feasible HZD gait (no
+    feasibility solve: it moves)."""
+    s = rabbit.build()
+    g = optimize_gait(s, speed=SPEED, nodes=10, guess="interpolate", step_time=0.4)
+    assert g.solver["iterations_total"] == g.solver["iterations"]
+    assert g.max_violation <= 1e-8 and g.speed == pytest.approx(SPEED, rel=1e-9)
+    assert np.abs(_outputs_on_gait(s, g)).max() <= 1e-8

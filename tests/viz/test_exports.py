@@ -139,10 +139,10 @@ def test_viewer_time_series_panel_follows_the_playhead(compass, pendulum, tmp_pa
         pytest.skip("headless Chromium not found (apt-get install chromium)")
     walk = amble.simulate(compass, steps=2)
 
-    def panel(path, t):
+    def panel(path, t, extra=""):
         proc = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
                                "--disable-dev-shm-usage", f"--user-data-dir={tmp_path / f'p{t}'}",
-                               "--virtual-time-budget=1000", "--dump-dom", path.as_uri() + f"#t={t}"],
+                               "--virtual-time-budget=1000", "--dump-dom", path.as_uri() + f"#t={t}{extra}"],
                               capture_output=True, text=True, timeout=60)
         assert proc.returncode == 0, proc.stderr[-2000:]
         return re.search(r"<canvas[^>]*id=\"series\"[^>]*>", proc.stdout).group(0)
@@ -152,6 +152,7 @@ def test_viewer_time_series_panel_follows_the_playhead(compass, pendulum, tmp_pa
         tag = panel(path, t)
         assert "hidden" not in tag and 'data-series="stance,swing,energy"' in tag, tag
         assert f'data-playhead="{t:.3f}"' in tag, tag
+    assert "display: none" in panel(path, 0.25, "&ui=0")  # a bare figure: no overlay over the robot
     scene = scene_of(walk, fps=30, series=["swing_dot"])
     assert list(scene["series"]) == ["swing_dot"] and len(scene["series"]["swing_dot"]) == len(scene["times"])
     bare = amble.animate(pendulum, tmp_path / "bare.html", fps=30, series=[])

@@ -15,19 +15,21 @@ import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import ConvergenceError, StateError
-from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, walk_many
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
 from .section import Section
 from .sweep_runner import compiled, point_key, run_sweep
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 #: Basin outcome categories (index = code stored in ``BasinResult.outcome``).
 BASIN_LABELS = ("converged", "fell", "not converged", "failed")
@@ -88,8 +90,8 @@ def _embed(k: Any, p: np.ndarray, section: tuple | None, idx: Sequence[int], S: 
 
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
                 base: list[float], fixed: list[float], to_state: Callable | None, steps: int, check_every: int,
-                tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None
-                ) -> list[dict[str, Any]]:
+                tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None,
+                threads: int = 1) -> list[dict[str, Any]]:
     """One or more grid rows: walk each cell with the compiled run loop, no recording.
 
     ``to_state`` ``None``: cells are put on the section (``section``: transition, time, pre-impact
@@ -101,25 +103,41 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     xs = np.asarray(fixed, float)
     b0 = np.asarray(base, float)
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
-    if to_state is None:
-        idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
-        to_state = _embed(k, p, None if section is None else tuple(section[:3]), idx,
-                          [] if section is None else section[3])
     cells = []  # (i, a, j, b, state or None, reason it has none)
-    for i, a in rows:
-        for j, b in enumerate(b_values):
-            try:
-                x = np.asarray(to_state(a, b, b0), float)
-            except ConvergenceError:  # no state of the section has these two coordinates here
+    if to_state is None and section is not None:
+        # the default embedding on the section: every cell's Newton solve in one compiled call
+        # (the GIL released, shared by the threads), not one Python iteration per cell
+        idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
+        grid = [(i, a, j, b) for i, a in rows for j, b in enumerate(b_values)]
+        raw = np.tile(b0, (len(grid), 1))
+        raw[:, idx[0]] = [g[1] for g in grid]
+        raw[:, idx[1]] = [g[3] for g in grid]
+        sec = Section(k, p, *section[:3])
+        for (i, a, j, b), x in zip(grid, sec.project_many(raw, section[3], threads=threads)):
+            if x is None:  # no state of the section has these two coordinates here
                 cells.append((i, a, j, b, None, "off the section"))
                 continue
-            ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
+            # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite
+            ok = x.shape == (n,) and math.isfinite(float(x.sum()))
             cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
+    else:
+        if to_state is None:
+            idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
+            to_state = _embed(k, p, None, idx, [])
+        for i, a in rows:
+            for j, b in enumerate(b_values):
+                try:
+                    x = np.asarray(to_state(a, b, b0), float)
+                except ConvergenceError:  # no state of the section has these two coordinates here
+                    cells.append((i, a, j, b, None, "off the section"))
+                    continue
+                ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
+                cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
     # every valid cell of the task in one compiled call (amble_walk_batch): the walks and their
     # convergence checks run in C with the GIL released, so threads and workers scale with cores
     valid = [c for c in cells if c[4] is not None]
     walks = walk_many(k, p, mi, np.array([c[4] for c in valid]).reshape(len(valid), n), xs, steps=steps,
-                      check_every=check_every, tol=tol, opts=opts) if valid else None
+                      check_every=check_every, tol=tol, opts=opts, threads=threads) if valid else None
     result = {(c[0], c[2]): w for w, c in enumerate(valid)}
     out = []
     for i, a, j, b, _x, why in cells:
@@ -157,6 +175,7 @@ def basin(
     max_points: int | None = None,
     rtol: float = BASIN_TOL,
     atol: float = BASIN_TOL,
+    threads: int = 1,
 ) -> BasinResult:
     """Basin of attraction of the period-1 gait over two post-impact coordinates.
 
@@ -172,7 +191,10 @@ def basin(
     ``|x − x*|∞ < tol``, ``fell`` if a terminal/fall event ended it, ``not converged`` if it kept
     walking elsewhere (another attractor or too slow), ``failed`` for any other run status.
     One Dask task per ``rows_per_task`` grid rows. ``rtol``/``atol``: integrator tolerances
-    (looser than for fixed points: only the outcome category matters here).
+    (looser than for fixed points: only the outcome category matters here). ``threads``: each
+    task's walks share this many threads of its process (with ``scheduler='synchronous'``: this
+    process) — the compiled walks release the GIL and take cells one by one, so two threads on
+    two cores walk a map in about half the time; the result does not depend on it.
     """
     from .poincare import ReturnMap, find_fixed_point
 
@@ -182,6 +204,8 @@ def basin(
             raise StateError(f"unknown coordinate {nm!r}; known: {', '.join(snames)}")
     if len(set(x_names)) != 2:
         raise StateError(f"basin: two different coordinates are needed, got {', '.join(x_names)}")
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise StateError(f"threads must be an integer ≥ 1, got {threads!r}")
     if len(n) != 2 or min(n) < 1 or steps < 1 or check_every < 1 or rows_per_task < 1:
         raise StateError("need n = (na ≥ 1, nb ≥ 1), steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
     av = np.linspace(ranges[0][0], ranges[0][1], int(n[0]))
@@ -206,7 +230,7 @@ def basin(
 
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
-                to_state, steps, check_every, tol, rtol, atol, list(x_names), section)
+                to_state, steps, check_every, tol, rtol, atol, list(x_names), section, threads)
 
     res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
                     groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,

@@ -14,13 +14,12 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.kernels import build
 from ..errors import AmbleError, StateError
-from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, run
 from ..simulation.simulate import parameter_vector
 from .defaults import BIFURCATION_TOL
@@ -28,6 +27,9 @@ from .runner import chunks, sweep_values
 from .section import Section
 from .store import ResultStore, SweepResult, state_columns
 from .sweep_runner import compiled, point_key, run_sweep, seed_before
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 
 def _onto_section(system: HybridSystem, params: Mapping[str, float], x: np.ndarray, rtol: float,

@@ -46,15 +46,17 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import AmbleError, ConvergenceError, StateError
-from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import run
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .section import Section
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 #: A located bifurcation's parameter is known to this (parameter units) or better.
 LOCATE_TOL = 1e-12

@@ -17,17 +17,19 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import AmbleError, OutputError
-from ..modelling.hybrid import HybridSystem
 from .continuation import Branch, BranchPoint, cascade
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .runner import sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns
 from .sweep_runner import compiled
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 
 def continuation_columns(param: str, snames: Sequence[str]) -> dict[str, str]:

@@ -15,17 +15,19 @@ import json
 import math
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.kernels import build
 from ..errors import AmbleError, StateError
-from ..modelling.hybrid import HybridSystem
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .runner import chunks, sweep_values
 from .store import ResultStore, SweepResult, state_columns
 from .sweep_runner import compiled, point_key, run_sweep, seed_before
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 
 def _fp_columns(pnames: Sequence[str], snames: Sequence[str]) -> dict[str, str]:

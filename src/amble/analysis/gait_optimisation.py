@@ -1,4 +1,5 @@
-"""Gait design by optimisation: one periodic step of a walker by direct collocation.
+"""Gait design by optimisation: one periodic step of a walker (or a period of several steps,
+``steps=2``) by direct collocation.
 
 The unknowns are the states, accelerations and inputs at the ``2N + 1`` Hermite–Simpson points of
 one step (:mod:`amble.analysis.collocation`), the free step time ``T``, and the impact's
@@ -21,8 +22,10 @@ Objectives, all per unit distance walked: ``effort`` ``(1/L) ∫ ‖u‖² dt``,
 transport) ``(1/(mₜ g L)) ∫ Σ |u_j v_j| dt`` with ``v = Bᵀq̇`` (each power split into its positive
 and negative parts, ``u_j v_j = p⁺ − p⁻``, ``p± ≥ 0``, so that ``|u_j v_j| = p⁺ + p⁻`` at the optimum
 without a kink), or a user expression
-``c(q, q̇, u)``: ``(1/L) ∫ c dt``. CasADi builds the problem from amble's derived expressions
-(:mod:`amble.backend.casadi_export`) with exact sparse first and second derivatives; IPOPT solves it.
+``c(q, q̇, u)``: ``(1/L) ∫ c dt``. With a pace given, ``L`` in the objective is its constrained value
+(``V T`` or the step length), which keeps the objective bounded away from feasible points.
+CasADi builds the problem from amble's derived expressions (:mod:`amble.backend.casadi_export`)
+with exact sparse first and second derivatives; IPOPT solves it.
 """
 
 from __future__ import annotations
@@ -42,7 +45,8 @@ from ..modelling.hybrid import HybridSystem
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
 from .gait_result import Gait, bezier_fit, constraint_report
-from .gait_start import initial_guess
+from .gait_stages import period_gait, solve_stages
+from .gait_start import initial_guess, start_vector
 
 OBJECTIVES = ("effort", "cot")
 
@@ -76,8 +80,10 @@ def optimize_gait(
     phase: Any = None,
     max_iter: int = 500,
     tol: float = 1e-10,
-    hzd: bool = False,
+    hzd: bool | None = None,
     progress: bool = False,
+    steps: int = 1,
+    step_params: Sequence[Mapping[str, float]] | None = None,
 ) -> Gait:
     """A periodic one-step gait of a one-mode walker that minimises ``objective``.
 
@@ -87,9 +93,12 @@ def optimize_gait(
     list (e.g. ``[20, 60]``) solves on each mesh in turn, each started from the previous solution
     (mesh refinement: the coarse solve finds the gait, the fine one makes it accurate).
     ``guess``: a post-impact state to start from (walked passively for one step where that
-    works), ``"passive"`` (the default: a passive step on the system's own gait), ``"stand"``
-    (standing still in the posture of the system's guess for ``step_time``) or ``"interpolate"``
-    (from that posture to the relabelled one); see :func:`~amble.analysis.gait_start.initial_guess`.
+    works), ``"passive"`` (a passive step on the system's own gait: the default of a model
+    without feedback), ``"stand"`` (standing still in the posture of the system's guess for
+    ``step_time``: the default of a model under feedback, e.g. with virtual constraints) or
+    ``"interpolate"`` (from that posture to the relabelled one); see
+    :func:`~amble.analysis.gait_start.initial_guess`. A start without motion is solved first for
+    the constraints alone (see :func:`~amble.analysis.gait_stages.solve_stages`).
     ``posture``: the coordinates (rad, m) of a ``"stand"`` or ``"interpolate"`` start instead of
     the system's guess (e.g. a stride held still in double support).
     ``bounds``: ``{state name: (low, high)}`` limits on coordinates or velocities at every point.
@@ -102,8 +111,14 @@ def optimize_gait(
     ``hzd``: the gait satisfies its virtual constraints exactly — each output is a Bézier
     polynomial (coefficients unknowns of the problem) in the phase at the mesh points — so that
     the HZD controller with the exported ``bezier`` (the optimised ``α``) reproduces it (FROST's
-    formulation).
+    formulation). Default: on for a model that declares virtual constraints, off otherwise.
     ``progress``: solver iterations and constraint violation on stderr.
+    ``steps``: steps per period (default 1). With ``steps=2`` each step has its own unknowns,
+    footfall, impact and relabelling into the next step (the last into the first); a ``speed``
+    holds over the period, a ``step_length`` for each step, the objective is the period's per unit
+    distance; ``step_params`` (one mapping per step) overrides parameter values step by step
+    (e.g. leg masses of a robot whose legs differ, swapped from one step to the next). The
+    result's fields are the first step's and :attr:`Gait.steps` holds every step.
 
     Raises :class:`ParameterError` / :class:`StateError` / :class:`ModelError` on bad input and
     :class:`SolverError` (naming the reason and the most violated constraint) when IPOPT fails.
@@ -120,101 +135,139 @@ def optimize_gait(
     if not sizes or not all(isinstance(k, int) and 2 <= k <= 2000 for k in sizes):
         raise ParameterError(f"nodes must be an integer in [2, 2000] (or a list of them), got {nodes!r}")
     vc = getattr(system.modes[system.mode_names[0]], "virtual", None)
+    if hzd is None:
+        hzd = vc is not None
     if bezier_degree is None:
         bezier_degree = vc.degree if vc is not None else 5
     if not (isinstance(bezier_degree, int) and 1 <= bezier_degree <= 20):
         raise ParameterError(f"bezier_degree must be an integer in [1, 20], got {bezier_degree!r}")
     if not (isinstance(max_iter, int) and max_iter >= 1):
         raise ParameterError(f"max_iter must be an integer ≥ 1, got {max_iter!r}")
+    if not (isinstance(steps, int) and 1 <= steps <= 8):
+        raise ParameterError(f"steps must be an integer in [1, 8], got {steps!r}")
+    S = steps
     pvals = _parameters(system, params)
+    if step_params is not None and len(step_params) != S:
+        raise ParameterError(f"step_params must hold one mapping per step ({S}), got {len(step_params)}")
+    pvs = [_parameters(system, {**pvals, **dict(sp_ or {})}) for sp_ in (step_params or [{}] * S)]
     model = system.modes[system.mode_names[0]]
     integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
     fns = step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
     n, nu, d = fns.n, fns.nu, fns.dims
-    P = np.array([pvals[k] for k in fns.param_names])
+    Ps = [np.array([pv[k] for k in fns.param_names]) for pv in pvs]
 
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
-    x_guess, t_guess = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture)
-    warm: Gait | None = None
+    guesses = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture, steps=S)
+    x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
     total_iter, total_time = 0, 0.0
 
-    def solve(N: int, x_guess: np.ndarray, t_guess: float, warm: Gait | None, hzd: bool) -> Gait:
-        # ------------------------------------------------------------------ unknowns
-        # MX with each model function mapped over the points: the graph holds one copy of each
-        # function, not 2N + 1 inlined ones (building the problem is then independent of N)
+    def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
+              feasibility: bool = False, refine: bool = True) -> list[Gait]:
+        """One NLP over the ``S`` steps of a period: a block of unknowns per step ``(X, A, U, T, qe,
+        λ, power, α)``; each step's footfall, impact and relabelling lead into the next step's first
+        state, the last step's into the first's."""
         K = 2 * N + 1
-        X, A, U = ca.MX.sym("x", 2 * n, K), ca.MX.sym("a", n, K), ca.MX.sym("u", nu, K)
-        Tv, QE, LAM = ca.MX.sym("T"), ca.MX.sym("qe", n + d), ca.MX.sym("lam", d)
         cot = isinstance(objective, str) and objective == "cot"
-        PW = ca.MX.sym("power", 2 * nu if cot else 0, K)  # positive and negative parts of each input's power
         Mb = bezier_degree
-        AL = ca.MX.sym("alpha", nu if hzd else 0, Mb + 1)  # Bézier coefficients of the virtual constraints
-        w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(AL))
-        h = Tv / N
-        taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
-        Q, V = X[:n, :], X[n:, :]
-        F = ca.vertcat(V, A)
-
         groups: list[tuple[str, Any, float, float]] = []  # (name, expression, lower, upper)
 
         def add(name: str, expr: Any, lo: float = 0.0, hi: float = 0.0) -> None:
             if expr.numel():
                 groups.append((name, ca.vec(expr), lo, hi))
 
-        add("dynamics", fns.dynamics.map(K)(Q, V, A, U, taus, P))
-        add("collocation", ca.vertcat(*defects([X[:, 0:-1:2], X[:, 1::2], X[:, 2::2]],
-                                               [F[:, 0:-1:2], F[:, 1::2], F[:, 2::2]], h)))
-        qN, vN = X[:n, -1], X[n:, -1]
-        add("impact", fns.impact(qN, vN, QE, LAM, P))
-        add("periodicity", fns.relabel(qN, QE, P) - X[:, 0])
-        add("guard", fns.guard(qN, vN, P))
-        add("guard_enabled", fns.enabled(qN, vN, P), 0.0, np.inf)
-        L = fns.distance(qN, P)
-        if speed is not None:
-            add("speed", L - speed * Tv)
-        elif step_length is not None:
-            add("step_length", L - step_length)
-        nrm = fns.normal(P)
-        add("impact_impulse", ca.dot(nrm, LAM), 0.0, np.inf)
-        add("liftoff", ca.dot(nrm, QE[n:]), 0.0, np.inf)
-        forces = fns.contact.map(K)(Q, V, A, P)  # d × K
-        normals = ca.mtimes(nrm.T, forces)
-        add("contact", normals, 0.0, np.inf)
-        if mu is not None:
-            tangential = forces - ca.mtimes(nrm, normals)
-            add("friction", mu**2 * normals**2 - ca.sum1(tangential**2), 0.0, np.inf)
-        if clearance is not None and K > 2:
-            s_ = np.arange(1, K - 1) / (K - 1)
-            lift = fns.guard.map(K - 2)(Q[:, 1:-1], V[:, 1:-1], P)
-            add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
-        if hzd:
-            add("virtual_constraints", virtual_constraints(fns, X, P, x_guess, AL))
-
-        # ------------------------------------------------------------------ objective
+        ws, lbws, ubws, w0s, bound_groups = [], [], [], [], []
+        Xs, QEs, Ts, integrals, dists, Ls = [], [], [], [], [], []
         wts = ca.DM(simpson_weights(N))
-        if objective == "effort":
-            run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
-            scale = 1.0
-        elif cot:
-            add("power", U * fns.actuator_rates.map(K)(Q, V, P) - (PW[:nu, :] - PW[nu:, :]))
-            run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
-            scale = 1.0 / float(fns.weight(P))
-        else:
-            run = fns.integrand.map(K)(Q, V, U, taus, P)
-            scale = 1.0
-        J = scale * h * ca.mtimes(run, wts) / L
-
-        # ------------------------------------------------------------------ bounds
-        lbw, ubw = _bounds(model, fns, bounds, N, t_guess)
-        lbw = np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)])
-        ubw = np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)])
+        offset = 0
+        for j in range(S):
+            Pj, xg, tg, wj = Ps[j], x_guesses[j], t_guesses[j], warms[j] if warms else None
+            # MX with each model function mapped over the points: the graph holds one copy of each
+            # function, not 2N + 1 inlined ones (building the problem is then independent of N)
+            X, A, U = ca.MX.sym(f"x{j}", 2 * n, K), ca.MX.sym(f"a{j}", n, K), ca.MX.sym(f"u{j}", nu, K)
+            Tv, QE, LAM = ca.MX.sym(f"T{j}"), ca.MX.sym(f"qe{j}", n + d), ca.MX.sym(f"lam{j}", d)
+            PW = ca.MX.sym(f"power{j}", 2 * nu if cot else 0, K)  # positive and negative parts of each power
+            AL = ca.MX.sym(f"alpha{j}", nu if hzd else 0, Mb + 1)  # Bézier coefficients of the virtual constraints
+            w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(AL))
+            h = Tv / N
+            taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
+            Q, V = X[:n, :], X[n:, :]
+            F = ca.vertcat(V, A)
+            add("dynamics", fns.dynamics.map(K)(Q, V, A, U, taus, Pj))
+            add("collocation", ca.vertcat(*defects([X[:, 0:-1:2], X[:, 1::2], X[:, 2::2]],
+                                                   [F[:, 0:-1:2], F[:, 1::2], F[:, 2::2]], h)))
+            qN, vN = X[:n, -1], X[n:, -1]
+            add("impact", fns.impact(qN, vN, QE, LAM, Pj))
+            add("guard", fns.guard(qN, vN, Pj))
+            add("guard_enabled", fns.enabled(qN, vN, Pj), 0.0, np.inf)
+            L = fns.distance(qN, Pj)
+            if step_length is not None:
+                add("step_length", L - step_length)
+            nrm = fns.normal(Pj)
+            add("impact_impulse", ca.dot(nrm, LAM), 0.0, np.inf)
+            add("liftoff", ca.dot(nrm, QE[n:]), 0.0, np.inf)
+            forces = fns.contact.map(K)(Q, V, A, Pj)  # d × K
+            normals = ca.mtimes(nrm.T, forces)
+            add("contact", normals, 0.0, np.inf)
+            if mu is not None:
+                tangential = forces - ca.mtimes(nrm, normals)
+                add("friction", mu**2 * normals**2 - ca.sum1(tangential**2), 0.0, np.inf)
+            if clearance is not None and K > 2:
+                s_ = np.arange(1, K - 1) / (K - 1)
+                lift = fns.guard.map(K - 2)(Q[:, 1:-1], V[:, 1:-1], Pj)
+                add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
+            if hzd:
+                add("virtual_constraints", virtual_constraints(fns, X, Pj, xg, AL))
+            if objective == "effort":
+                run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
+                scale = 1.0
+            elif cot:
+                add("power", U * fns.actuator_rates.map(K)(Q, V, Pj) - (PW[:nu, :] - PW[nu:, :]))
+                run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
+                scale = 1.0 / float(fns.weight(Pj))
+            else:
+                run = fns.integrand.map(K)(Q, V, U, taus, Pj)
+                scale = 1.0
+            integrals.append(scale * h * ca.mtimes(run, wts))
+            # per unit distance: with the pace given, the distance is divided by its constrained
+            # value (V T or the step length), not by the foot's position — equal at a feasible
+            # point, but away from one (standing still: the swing foot behind the stance foot,
+            # L ≤ 0) L is not bounded away from zero and the objective ∫u²/L is unbounded below
+            dists.append(speed * Tv if speed is not None else step_length if step_length is not None else L)
+            Xs.append(X)
+            QEs.append(QE)
+            Ts.append(Tv)
+            Ls.append(L)
+            # bounds
+            lbw, ubw = _bounds(model, fns, bounds, N, tg)
+            if feasibility:
+                # the step time held at the guess's: free, it collapses to its lower bound (standing
+                # still, the defects h·f of a falling robot shrink with h = T/N), where no step fits
+                it = (3 * n + nu) * K
+                lbw[it] = ubw[it] = tg
+            lbws.append(np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)]))
+            ubws.append(np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)]))
+            alpha0 = (np.array(wj.bezier["alpha"]) if hzd and wj is not None and wj.bezier
+                      else bezier_start(fns, xg, Pj, Mb) if hzd else np.zeros(0))
+            w0s.append(np.concatenate([start_vector(fns, xg, tg, N, Pj, wj), np.zeros(PW.numel()),
+                                       alpha0.ravel(order="F")]))
+            bound_groups += [(name, offset + lo, offset + hi) for name, lo, hi in _bound_groups(fns, N)]
+            offset += w.numel()
+            ws.append(w)
+        for j in range(S):  # each footfall leads into the next step (the last into the first)
+            qN = Xs[j][:n, -1]
+            add("periodicity", fns.relabel(qN, QEs[j], Ps[j]) - Xs[(j + 1) % S][:, 0])
+        if speed is not None:  # the pace of the whole period
+            add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
+        J = sum(integrals[1:], integrals[0]) / sum(dists[1:], dists[0])
+        if feasibility:
+            # a first solve from a start without motion looks for any step (no objective): see gait_stages.solve_stages
+            J = ca.MX(0.0)
+        w = ca.vertcat(*ws)
+        lbw, ubw = np.concatenate(lbws), np.concatenate(ubws)
+        w0 = np.concatenate(w0s)
         g = ca.vertcat(*[e for _, e, _, _ in groups])
         lbg = np.concatenate([np.full(e.numel(), lo) for _, e, lo, _ in groups])
         ubg = np.concatenate([np.full(e.numel(), hi) for _, e, _, hi in groups])
-        alpha0 = (np.array(warm.bezier["alpha"]) if hzd and warm is not None and warm.bezier
-                  else bezier_start(fns, x_guess, P, Mb) if hzd else np.zeros(0))
-        w0 = np.concatenate([_start_vector(fns, x_guess, t_guess, N, P, warm), np.zeros(PW.numel()),
-                             alpha0.ravel(order="F")])
         n_eq = int(np.sum(lbg == ubg))
         if n_eq > w.numel():
             pace = " and a speed or step length" if (speed or step_length) else ""
@@ -225,7 +278,7 @@ def optimize_gait(
         opts = {"ipopt.tol": tol, "ipopt.constr_viol_tol": min(tol, 1e-10), "ipopt.max_iter": max_iter,
                 "ipopt.print_level": 5 if progress else 0, "print_time": False, "ipopt.sb": "yes",
                 "ipopt.mu_strategy": "adaptive"}
-        if warm is not None:
+        if warms is not None and refine:
             # a finer mesh starts next to the coarse optimum: a small barrier parameter and a start
             # kept where it is (not pushed into the interior) take a handful of iterations instead
             # of re-solving from a central path (RABBIT 20 → 60 intervals: 10 iterations, not 83)
@@ -239,7 +292,7 @@ def optimize_gait(
         stats = solver.stats()
         wopt = np.asarray(sol["x"]).ravel()
         gval = np.asarray(sol["g"]).ravel()
-        report = constraint_report(groups, gval, lbg, ubg, wopt, lbw, ubw, _bound_groups(fns, N))
+        report = constraint_report(groups, gval, lbg, ubg, wopt, lbw, ubw, bound_groups)
         status = stats.get("return_status", "unknown")
         if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
             worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
@@ -249,24 +302,26 @@ def optimize_gait(
                        else "every constraint holds at the last iterate (the optimality conditions do not)")
             raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
                               f"{binding}")
-        return _gait(system, model, fns, pvals, wopt, N, objective, float(sol["f"]), report,
-                     {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed,
-                      "nodes": N}, bezier_degree, hzd)
+        info = {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed, "nodes": N}
+        out, start = [], 0
+        for j in range(S):
+            size = ws[j].numel()
+            out.append(_gait(system, model, fns, pvs[j], wopt[start:start + size], N, objective, float(sol["f"]),
+                             report, dict(info), bezier_degree, hzd))
+            start += size
+        return out
 
-    theta = [float(fns.phase(x_guess[i, :n], P)) for i in (0, -1)]
-    presolve = hzd and not theta[1] - theta[0] > 1e-9
-    if presolve:
-        # the start does not move (standing): no phase to write virtual constraints in; a first
-        # solve without them finds a step, and the virtual constraints start from it
-        levels = [levels[0], *levels]
-    for i, N in enumerate(levels):
-        if warm is not None:  # a finer mesh starts from the coarser solution, interpolated
-            tau = np.linspace(0.0, warm.step_time, 2 * N + 1)
-            x_guess, t_guess = warm.state(tau), warm.step_time
-        warm = solve(N, x_guess, t_guess, warm, hzd and not (presolve and i == 0))
-        total_iter += warm.solver["iterations"]
-        total_time += warm.solver["time_s"]
-    assert warm is not None
+    stages = solve_stages(fns, x_guesses[0], Ps[0], levels, hzd)
+    warms: list[Gait] | None = None
+    for N, with_vc, feasible, refine in stages:
+        if warms is not None:  # a later stage starts from the previous solution, interpolated
+            x_guesses = [wg.state(np.linspace(0.0, wg.step_time, 2 * N + 1)) for wg in warms]
+            t_guesses = [wg.step_time for wg in warms]
+        warms = solve(N, x_guesses, t_guesses, warms, with_vc, feasible, refine)
+        total_iter += warms[0].solver["iterations"]
+        total_time += warms[0].solver["time_s"]
+    assert warms is not None
+    warm = warms[0] if S == 1 else period_gait(warms)
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
     return warm
 
@@ -333,23 +388,6 @@ def _bound_groups(fns: StepFunctions, N: int) -> list[tuple[str, int, int]]:
     s = 2 * n * K + n * K
     return [("joint_limits", 0, 2 * n * K), ("actuator_limits", s, s + nu * K), ("step_time", s + nu * K,
                                                                                    s + nu * K + 1)]
-
-
-def _start_vector(fns: StepFunctions, x: np.ndarray, T: float, N: int, P: np.ndarray, warm: Gait | None = None
-                  ) -> np.ndarray:
-    """Unknowns from a guessed trajectory ``x`` (``(2N + 1) × 2n``): accelerations by differences,
-    inputs zero, the impact's unknowns from the guessed pre-impact state; from a coarser solution
-    ``warm``, its accelerations, inputs and impulse interpolated."""
-    n, nu, d, K = fns.n, fns.nu, fns.dims, 2 * N + 1
-    tau = np.linspace(0.0, T, K)
-    a = np.gradient(x[:, n:], tau, axis=0) if K > 2 else np.zeros((K, n))
-    u = np.zeros((K, nu))
-    qe, lam = np.concatenate([x[-1, n:], np.zeros(d)]), np.zeros(d)
-    if warm is not None:
-        a = np.column_stack([np.interp(tau, warm.times, warm.accelerations[:, i]) for i in range(n)])
-        u = warm.input(tau) if nu else u
-        qe, lam = warm.extended_velocity, warm.impulse
-    return np.concatenate([x.ravel(), a.ravel(), u.ravel(), [T], qe, lam])
 
 
 def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: np.ndarray, N: int,

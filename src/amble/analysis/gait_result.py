@@ -58,6 +58,11 @@ class Gait:
     #: the ground's force on the stance foot at the collocation points (N, world axes of the
     #: step's frame: ``(x, z)`` in 2D, ``(x, y, z)`` in 3D)
     contact_forces: np.ndarray | None = None
+    #: a gait of several steps per period (``optimize_gait(steps=k)``): every step, in order, each
+    #: a :class:`Gait` of its own (its trajectory, impact, step time and Bézier coefficients); the
+    #: fields above are then the first step's, except ``speed`` (the period's: Σ L / Σ T) and
+    #: ``objective`` (the period's). None for a one-step gait
+    steps: list[Gait] | None = None
 
     def state(self, t: Any) -> np.ndarray:
         """The collocation solution at times ``t`` (s, within the step), by its Hermite interpolant."""
@@ -119,6 +124,7 @@ class Gait:
                            "contact_force": None if self.contact_forces is None else self.contact_forces.tolist()},
             "constraints": self.constraints, "max_violation": self.max_violation,
             "bezier": self.bezier, "solver": self.solver,
+            **({"period": len(self.steps), "steps": [_step_json(g) for g in self.steps]} if self.steps else {}),
         }
 
     def save(self, path: str | Path) -> Path:
@@ -133,6 +139,16 @@ class Gait:
         except OSError as e:
             raise OutputError(f"{p}: cannot write ({e.strerror})") from None
         return p
+
+
+def _step_json(g: Gait) -> dict[str, Any]:
+    """One step of a multi-step gait in ``gait.json`` (the period's report and solver are at the top)."""
+    d = g.to_json()
+    for k in ("constraints", "solver", "max_violation", "objective", "objective_name", "system", "state_names",
+              "input_names", "parameters"):
+        d.pop(k, None)
+    d["parameters"] = g.params
+    return d
 
 
 def constraint_report(groups: list, g: np.ndarray, lbg: np.ndarray, ubg: np.ndarray, w: np.ndarray,

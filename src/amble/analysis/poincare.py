@@ -20,18 +20,20 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.kernels import Kernels, build
 from ..errors import ConvergenceError, ModelError, SimulationError, StateError
-from ..modelling.hybrid import HybridSystem
 from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .section import Section
 from .section import chart as _chart
+
+if TYPE_CHECKING:
+    from ..modelling.hybrid import HybridSystem
 
 
 @dataclass

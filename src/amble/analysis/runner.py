@@ -12,14 +12,16 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.kernels import build
 from ..errors import ParameterError, SchedulerError, StateError
-from ..modelling.hybrid import HybridSystem
 from .store import ResultStore
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 
 class _Serial:

@@ -181,5 +181,28 @@ class Section:
         raise ConvergenceError(f"no state on the section has these section coordinates near the reference "
                                f"(residual {res:.3g})")
 
+    def project_many(self, x: np.ndarray, S: Sequence[int], *, tol: float = PROJECT_TOL, max_iter: int = 30,
+                     threads: int = 1) -> list[np.ndarray | None]:
+        """:meth:`project` of every row of ``x``, the iteration in one compiled call (the GIL
+        released, rows shared by ``threads`` threads); ``None`` for a row with no state of Σ
+        (where :meth:`project` raises :class:`ConvergenceError`). A row the compiled iteration
+        cannot decide (a rank-deficient step, a failing reset) is projected by :meth:`project`."""
+        x = np.asarray(x, float)
+        n = self.k.meta["nx"][self.target]
+        if x.ndim != 2 or x.shape[1] != n:
+            raise StateError(f"project: states of the section's mode have {n} values, got shape {x.shape}")
+        y, ok = self.k.project_batch(self.source, self.tr, self.row, self.t, self.pre, np.asarray(S, int), x, self.p,
+                                     tol, max_iter, threads)
+        out: list[np.ndarray | None] = []
+        for r in range(len(x)):
+            if ok[r]:
+                out.append(y[r, :n].copy())
+                continue
+            try:
+                out.append(self.project(x[r], S, tol=tol, max_iter=max_iter))
+            except ConvergenceError:
+                out.append(None)
+        return out
+
 
 __all__ = ["PROJECT_TOL", "RANK_TOL", "Section", "chart"]

@@ -13,15 +13,17 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.kernels import build
-from ..modelling.hybrid import HybridSystem
 from ..simulation.simulate import parameter_vector
 from .runner import check_params, execute, open_client
 from .store import ResultStore, SweepResult, fmt_value, state_from_row
+
+if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 Key = tuple[str, ...]
 

@@ -2,9 +2,10 @@
 
 Everything both languages must agree on is listed here once: the run status codes, the fields of
 the resumable context array ``ctx``, of the real and integer option arrays ``opt`` and ``iopt``,
-and the integer width of counters. The C header the engine includes is generated from these
-tables (:func:`c_header`), and a loaded library reports its layout back, which is compared with
-:data:`LAYOUT` at load — a stale library is refused instead of misread.
+the layout of the sensitivity buffer, and the integer width of counters. The C header the engine
+includes is generated from these tables (:func:`c_header`), and a loaded library reports its
+layout back, which is compared with :data:`LAYOUT` at load — a stale library is refused instead
+of misread.
 """
 
 from __future__ import annotations
@@ -61,6 +62,42 @@ IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZEN
                                 "MAXISTEPS", "MAXISTEPS_EV", "YIELDN",
                                 "METHOD")  # integrator: 0 DOP853 (explicit), 1 Radau IIA (implicit, stiff)
 
+#: The sensitivity buffer (float64, ``_c/sensitivity.h``) of a run that carries ∂x/∂(x0, p), in
+#: order: (name, size as coefficients (a, b, c) of ``a·NXMAX·SC + b·SC + c``). ``NXMAX`` is a
+#: library's longest state, ``SC = NXMAX + NPARAM`` the columns of a sensitivity row (state
+#: columns 0 … nx0−1, parameter j at NXMAX + j). Offsets are the sums of the sizes before.
+SENS_FIELDS: tuple[tuple[str, tuple[int, int, int]], ...] = (
+    ("S", (1, 0, 0)),    # ∂x/∂(x0, p): NXMAX rows of SC columns, row-major
+    ("TAU", (0, 1, 0)),  # dτ of the last transition: one row of SC columns
+    ("NCS", (0, 0, 1)),  # state columns carried (the initial state's size)
+    ("NCP", (0, 0, 1)),  # parameter columns carried (0 or NPARAM)
+)
+
+
+def _sens_offsets() -> dict[str, tuple[int, int, int]]:
+    """Offset of each sensitivity field, and ``SIZE`` (the whole buffer), as coefficients."""
+    out, acc = {}, (0, 0, 0)
+    for name, size in SENS_FIELDS:
+        out[name] = acc
+        acc = tuple(a + b for a, b in zip(acc, size))
+    out["SIZE"] = acc
+    return out
+
+
+def sens_layout(nx_max: int, sc: int) -> dict[str, int]:
+    """Offsets (entries of float64) of the sensitivity fields in the buffer of a library with
+    longest state ``nx_max`` and ``sc`` columns per sensitivity row, and ``SIZE``, its length."""
+    return {name: a * nx_max * sc + b * sc + c for name, (a, b, c) in _sens_offsets().items()}
+
+
+def _sens_c(coef: tuple[int, int, int]) -> str:
+    """A C expression of ``a·NXMAX·SC + b·SC + c`` (macros of the generated unit)."""
+    a, b, c = coef
+    terms = [t for t in ((f"{a} * NXMAX * SC" if a != 1 else "NXMAX * SC") if a else "",
+                         (f"{b} * SC" if b != 1 else "SC") if b else "", str(c) if c else "") if t]
+    return f"({' + '.join(terms)})" if terms else "0"
+
+
 CTX = {name: i for i, name in enumerate(CTX_FIELDS)}
 OPT = {name: i for i, name in enumerate(OPT_FIELDS)}
 IOPT = {name: i for i, name in enumerate(IOPT_FIELDS)}
@@ -73,6 +110,7 @@ assert len(CTX_FIELDS) <= CTX_X, "ctx fields overlap the state vector"
 def _layout_text() -> str:
     parts = [f"ST_{n}={c}" for c, n, _ in STATUS] + [f"CX_{n}={i}" for n, i in CTX.items()] + [f"CX_X={CTX_X}"]
     parts += [f"OP_{n}={i}" for n, i in OPT.items()] + [f"IO_{n}={i}" for n, i in IOPT.items()]
+    parts += [f"SENS_{n}={c}" for n, c in _sens_offsets().items()]
     return ";".join(parts)
 
 
@@ -81,14 +119,16 @@ LAYOUT = int(hashlib.sha256(_layout_text().encode()).hexdigest()[:15], 16)
 
 
 def c_header(layout: int | None = None) -> str:
-    """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*`` and
-    ``AMBLE_LAYOUT`` (default :data:`LAYOUT`), written into every generated translation unit
-    before the engine is included. Integer arrays shared with NumPy int64 are ``int64_t``."""
+    """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*``, ``SENS_*``
+    (offsets in terms of the unit's ``NXMAX`` and ``SC``) and ``AMBLE_LAYOUT`` (default
+    :data:`LAYOUT`), written into every generated translation unit before the engine is included.
+    Integer arrays shared with NumPy int64 are ``int64_t``."""
     lines = ["/* Python <-> C interface, generated from amble/backend/abi.py; do not edit. */",
              "#include <stdint.h>"]
     lines += [f"#define ST_{name} {code}" for code, name, _ in STATUS]
     lines += [f"#define CX_{name} {i}" for name, i in CTX.items()] + [f"#define CX_X {CTX_X}"]
     lines += [f"#define OP_{name} {i}" for name, i in OPT.items()]
     lines += [f"#define IO_{name} {i}" for name, i in IOPT.items()]
+    lines += [f"#define SENS_{name} {_sens_c(c)}" for name, c in _sens_offsets().items()]
     lines.append(f"#define AMBLE_LAYOUT {LAYOUT if layout is None else layout}LL")
     return "\n".join(lines) + "\n"

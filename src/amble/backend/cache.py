@@ -39,23 +39,22 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import shutil
-import subprocess
-import tempfile
 import time
 import warnings
 import weakref
 from functools import lru_cache
-from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import CompileError
-from ..modelling.dag import dag_srepr
-from ..modelling.hybrid import HybridSystem
 from ..version import __version__
 
-C_DIR = Path(str(resources.files("amble.backend") / "_c"))
+# shutil, subprocess and tempfile are imported where a library is compiled: a warm start needs none
+
+if TYPE_CHECKING:  # the lookup of a warm cache imports no SymPy (see backend/index.py)
+    from ..modelling.hybrid import HybridSystem
+
+C_DIR = Path(__file__).resolve().parent / "_c"  # a package on disk (importlib.resources costs ~10 ms)
 _PKG = Path(__file__).resolve().parents[1]
 
 #: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.
@@ -112,6 +111,8 @@ def cache_dir() -> Path:
         return d
     key = str(d)
     if key not in _FALLBACK:
+        import tempfile
+
         _FALLBACK[key] = Path(tempfile.mkdtemp(prefix="amble-cache-"))
         warnings.warn(f"amble: cache {d} is not usable ({why}); compiling into {_FALLBACK[key]} for this process",
                       CacheWarning, stacklevel=2)
@@ -141,6 +142,8 @@ def compiler() -> str:
 
 @lru_cache(maxsize=16)
 def _find_compiler(env_cc: str, path: str) -> str:
+    import shutil
+
     cc = env_cc.strip() or next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
     if cc is None or shutil.which(cc.split()[0]) is None:
         raise CompileError(
@@ -157,6 +160,8 @@ def cflags() -> list[str]:
 @lru_cache(maxsize=16)
 def compiler_identity(cc: str) -> str:
     """``cc --version`` output (once per compiler command); empty if it cannot be run."""
+    import subprocess
+
     try:
         r = subprocess.run([*cc.split(), "--version"], capture_output=True, text=True, timeout=60)
     except (OSError, subprocess.TimeoutExpired):
@@ -172,6 +177,8 @@ def toolchain() -> str:
 
 def _structure_digest(system: HybridSystem) -> str:
     """Hash of the system's structure (not parameter values or defaults)."""
+    from ..modelling.dag import dag_srepr  # SymPy: only when a key is computed from a system
+
     h = hashlib.sha256()
     for name, m in system.modes.items():
         parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]
@@ -295,6 +302,8 @@ def _write_atomic(path: Path, data: bytes) -> None:
 
 def _remove_orphans(d: Path) -> None:
     """Remove build directories and temporary files that a killed process left behind."""
+    import shutil
+
     now = time.time()
     for p in list(d.glob("build-*")) + list(d.glob(".*.tmp")):
         try:
@@ -306,6 +315,9 @@ def _remove_orphans(d: Path) -> None:
 
 def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
     """Compile ``src`` into ``d/<key>-<sha>.so``; returns the path and the library's SHA-256."""
+    import subprocess
+    import tempfile
+
     cc = compiler()
     with tempfile.TemporaryDirectory(prefix="build-", dir=d) as tmpd:
         c_file = Path(tmpd) / "model.c"

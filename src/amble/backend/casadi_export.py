@@ -259,7 +259,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
         raise ModelError(f"system {system.name!r}: the footfall {tr.name!r} must be an Impact (derived) reset, "
                          f"not {type(tr.reset).__name__}")
     m = system.modes[modes[0]]
-    eq = derive(m)
+    eq = derive(m, control=False)  # the inputs are unknowns of the problem: no feedback law
     n, d = len(m.q), m.dims
     inputs = list(getattr(m, "inputs", []) or [])
     B = getattr(eq, "B", None)

@@ -11,15 +11,18 @@ from __future__ import annotations
 
 import copy
 import ctypes
+import threading
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import CompileError, ModelError, StateError
-from ..modelling.hybrid import HybridSystem
 from . import abi, cache
 from .cache import cache_dir, structure_key
+
+if TYPE_CHECKING:  # loading a cached library imports no SymPy
+    from ..modelling.hybrid import HybridSystem
 
 __all__ = ["Kernels", "build", "cache_dir", "structure_key"]
 
@@ -36,7 +39,17 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
     ``derivatives``: also the derivative kernels (flow and reset Jacobians, guard gradients) that
     sensitivity runs, exact return-map Jacobians and the implicit integrator need. They are
     several times longer than the rest, so a library is built with them only when asked; one that
-    has them serves plain runs too, and is preferred when it is at hand."""
+    has them serves plain runs too, and is preferred when it is at hand.
+
+    A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
+    found by the warm-start index) is served those; without the ones asked for, its full system
+    is built."""
+    carried = getattr(type(system), "compiled_kernels", None)
+    if carried is not None:
+        k = carried(system, derivatives)
+        if k is not None:
+            return k
+        system = system.full()
     plain = cache.structure_key(system)
     full = cache.derivatives_key(plain)
     k = _LOADED.get(full) or (None if derivatives else _LOADED.get(plain))
@@ -109,9 +122,15 @@ class Kernels:
         lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         self.simulate_raw = lib.amble_simulate
         lib.amble_walk_batch.restype = None
-        lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_int] + [ctypes.c_void_p] * 5 + \
+        lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 5 + \
             [ctypes.c_int64, ctypes.c_int64, ctypes.c_double] + [ctypes.c_void_p] * 5
         self._walk_batch = lib.amble_walk_batch
+        lib.amble_project_batch.restype = None
+        lib.amble_project_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int,
+                                            ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int,
+                                            ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_int,
+                                            ctypes.c_void_p, ctypes.c_void_p]
+        self._project_batch = lib.amble_project_batch
 
     # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
     def mode_index(self, mode: str | int) -> int:
@@ -217,20 +236,26 @@ class Kernels:
         return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + npar].copy(), D[:nd, self.sc].copy()
 
     def walk_batch(self, mode: str | int, x0: np.ndarray, p: np.ndarray, opt: np.ndarray, iopt: np.ndarray,
-                   xref: np.ndarray, steps: int, check_every: int, tol: float) -> dict[str, np.ndarray]:
+                   xref: np.ndarray, steps: int, check_every: int, tol: float, threads: int = 1
+                   ) -> dict[str, np.ndarray]:
         """Walk every row of ``x0`` (initial states of ``mode`` at t = 0) for up to ``steps``
         footfalls in one compiled call (which releases the GIL), in runs of ``check_every``
         footfalls each started afresh from the last one's final state, stopping a walk when
         ``max |x − xref| < tol`` after a run. ``opt``/``iopt``: the run option layouts of
-        :mod:`amble.backend.abi` (capacities ignored: nothing is recorded). Returns per walk:
-        ``code`` (status of its last run), ``info`` (the transition that ended it, or −1),
-        ``steps`` (footfalls taken), ``distance`` (after the last completed run; NaN if none) and
-        ``x`` (final states, NaN-padded to ``nx_max``)."""
+        :mod:`amble.backend.abi` (capacities ignored: nothing is recorded). ``threads`` > 1:
+        that many threads call it at once on the same rows, taking the next unwalked row each
+        (one atomic counter), so unequal walks keep every thread busy to the end; each walk is
+        the same whichever thread takes it. Returns per walk: ``code`` (status of its last run),
+        ``info`` (the transition that ended it, or −1), ``steps`` (footfalls taken),
+        ``distance`` (after the last completed run; NaN if none) and ``x`` (final states,
+        NaN-padded to ``nx_max``)."""
         mi = self.mode_index(mode)
         nx = self.meta["nx"][mi]
         x0 = np.asarray(x0, dtype=float)
         if x0.ndim != 2 or x0.shape[1] != nx:
             raise StateError(f"initial states must be rows of {nx} entries, got shape {x0.shape}")
+        if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+            raise StateError(f"threads must be an integer ≥ 1, got {threads!r}")
         xref = _vec(xref, nx)
         n = x0.shape[0]
         xs = np.full((n, self.nx_max), np.nan)
@@ -241,9 +266,53 @@ class Kernels:
         out = {"code": np.zeros(n, dtype=np.int32), "info": np.zeros(n, dtype=np.int32),
                "steps": np.zeros(n, dtype=np.int64), "distance": np.zeros(n), "x": np.zeros((n, self.nx_max))}
         addr = lambda a: a.ctypes.data  # noqa: E731
-        self._walk_batch(n, mi, addr(xs), addr(p), addr(opt), addr(iopt), addr(xref), int(steps), int(check_every),
-                         float(tol), *(addr(out[k]) for k in ("code", "info", "steps", "distance", "x")))
+        threads = min(threads, n)
+        counter = np.zeros(1, dtype=np.int64)
+        args = (n, addr(counter) if threads > 1 else None, mi, addr(xs), addr(p), addr(opt), addr(iopt), addr(xref),
+                int(steps), int(check_every), float(tol),
+                *(addr(out[k]) for k in ("code", "info", "steps", "distance", "x")))
+        if threads <= 1:
+            self._walk_batch(*args)
+        else:
+            workers = [threading.Thread(target=self._walk_batch, args=args) for _ in range(threads - 1)]
+            for w in workers:
+                w.start()
+            self._walk_batch(*args)  # this thread takes rows too
+            for w in workers:
+                w.join()
         return out
+
+    def project_batch(self, mode: int, transition: int, row: int, t: float, pre: np.ndarray, S: np.ndarray,
+                      x: np.ndarray, p: np.ndarray, tol: float, max_iter: int, threads: int = 1
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """Put every row of ``x`` (states of the transition's target mode) on its post-impact
+        section in one compiled call, by the Newton iteration of
+        :meth:`amble.analysis.section.Section.project` from the pre-impact state ``pre`` (guard
+        ``row`` of ``mode``, time ``t``, section coordinates ``S``). Returns the post-impact states
+        (NaN-padded to ``nx_max``) and per row whether the iteration decided it (``False``: a
+        reset that failed, a rank-deficient step, no convergence — left to the full iteration).
+        ``threads`` as for :meth:`walk_batch`. Needs the derivative kernels."""
+        self._need_derivatives()
+        x = np.asarray(x, dtype=float)
+        n = x.shape[0]
+        xs = np.full((n, self.nx_max), np.nan)
+        xs[:, : x.shape[1]] = x
+        pre = np.ascontiguousarray(pre, dtype=float)
+        S = np.ascontiguousarray(S, dtype=np.int64)
+        p = np.ascontiguousarray(p, dtype=float)
+        y, ok = np.zeros((n, self.nx_max)), np.zeros(n, dtype=np.int32)
+        threads = max(1, min(int(threads), n))
+        counter = np.zeros(1, dtype=np.int64)
+        args = (n, counter.ctypes.data if threads > 1 else None, int(mode), int(transition), int(row), float(t),
+                pre.ctypes.data, S.ctypes.data, len(S), xs.ctypes.data, p.ctypes.data, float(tol), int(max_iter),
+                y.ctypes.data, ok.ctypes.data)
+        workers = [threading.Thread(target=self._project_batch, args=args) for _ in range(threads - 1)]
+        for w in workers:
+            w.start()
+        self._project_batch(*args)
+        for w in workers:
+            w.join()
+        return y, ok.astype(bool)
 
     def energy_rows(self, t: np.ndarray, modes: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         t, modes, x = _rows(t, modes, x, self.nx_max, self.n_modes)

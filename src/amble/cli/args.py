@@ -5,9 +5,9 @@ exit code 2) before work starts."""
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -103,6 +103,8 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
             open(p, "ab").close()  # opening to append changes nothing
         except OSError as e:
             raise OutputError(f"{what}: cannot write {path!r} ({e.strerror or e})") from None
+    import tempfile  # here, not at import: a command without output files never needs it
+
     try:
         fd, probe = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".probe", dir=parent)
         os.close(fd)
@@ -112,8 +114,23 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
     return p
 
 
-def load_model(name: str):
-    """A library model by name, or the system of a model file ``path/to/file.py[:callable]``."""
-    from ..models import is_file_spec, load, load_file
+def load_model(name: str, *, compiled: bool = False, derivatives: bool = False):
+    """A library model by name, or the system of a model file ``path/to/file.py[:callable]``.
 
-    return load_file(name) if is_file_spec(name) else load(name)
+    ``compiled``: a :class:`~amble.backend.compiled.CompiledSystem` when the warm-start index
+    (:mod:`amble.backend.index`) holds the model's compiled library (with the derivative kernels
+    if ``derivatives``) — no SymPy is imported; otherwise the model is built and its index entry
+    refreshed, so that the next run starts warm."""
+    from ..models import is_file_spec, load, load_file, load_traced, source_files
+
+    if not compiled:
+        return load_file(name) if is_file_spec(name) else load(name)
+    from ..backend import index
+
+    sources = source_files(name)
+    hit = index.lookup(name, sources, functools.partial(load_model, name), derivatives)
+    if hit is not None:
+        return hit
+    system, read = load_traced(name)
+    index.record(name, sources, system, read)
+    return system

@@ -66,6 +66,8 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--bezier-degree must be in [1, 20], got {args.bezier_degree}")
     if args.max_iter < 1:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
+    if not 1 <= args.steps <= 8:
+        raise UsageError(f"--steps must be in [1, 8], got {args.steps}")
     bounds = parse_bounds(args.bound)
     guess = _guess(args.guess)
     s = load_model(args.model)
@@ -80,7 +82,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
                          nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time,
                          posture=posture, mu=args.mu,
                          clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, hzd=args.hzd,
-                         bezier_degree=args.bezier_degree, progress=not args.quiet)
+                         bezier_degree=args.bezier_degree, progress=not args.quiet, steps=args.steps)
     out = gait.to_json()
     if out_p:
         write_output(out_p, gait.save, "--out")
@@ -92,6 +94,8 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
               f"step length {gait.step_length:.6g} m, speed {gait.speed:.6g} m/s ({its} iterations, {secs:.2f} s "
               f"in the solver, max violation {gait.max_violation:.1e})")
         print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(gait.state_names, gait.fixed_point)))
+        for j, step in enumerate(gait.steps or []):
+            print(f"step {j + 1}: step time {step.step_time:.6g} s, step length {step.step_length:.6g} m")
         active = [k for k, r in gait.constraints.items() if r["active"]]
         if active:
             print("active constraints: " + ", ".join(active))
@@ -115,7 +119,8 @@ def add_parser(add: Any, model_arg: Any) -> None:
                         "coordinates, velocities, inputs and parameters, integrated per m")
     o.add_argument("--nodes", default="30",
                    help="collocation intervals (default 30), or N1,N2,... to refine the mesh (e.g. 20,60)")
-    o.add_argument("--guess", help="'passive' (default: a passive step), 'stand' (standing still), 'interpolate' "
+    o.add_argument("--guess", help="'passive' (a passive step: the default without feedback), 'stand' (standing "
+                                   "still: the default of a model under feedback), 'interpolate' "
                                    "(posture to relabelled posture) or 'x0=V1,V2,...' (a post-impact state "
                                    "walked one step)")
     o.add_argument("--step-time", type=float, dest="step_time",
@@ -126,12 +131,17 @@ def add_parser(add: Any, model_arg: Any) -> None:
     o.add_argument("--clearance", type=float, help="swing-foot clearance at mid-step in m (default: none)")
     o.add_argument("--bound", action="append", metavar="NAME=LOW:HIGH",
                    help="limits of a coordinate or velocity over the step (repeatable; a side may be empty)")
-    o.add_argument("--hzd", action="store_true",
+    o.add_argument("--no-hzd", action="store_false", dest="hzd",
+                   help="no virtual constraints, even for a model that declares them")
+    o.add_argument("--hzd", action="store_true", default=None,
                    help="make the gait satisfy Bézier virtual constraints (their α are optimised too), so "
-                        "that an HZD controller with the exported α reproduces it")
+                        "that an HZD controller with the exported α reproduces it (default: on for a model "
+                        "that declares virtual constraints)")
     o.add_argument("--bezier-degree", type=int, default=None, dest="bezier_degree",
                    help="degree of the Bézier virtual constraints (default: the model's own, else 5)")
+    o.add_argument("--steps", type=int, default=1,
+                   help="steps per period (default 1; 2: a two-step gait, each step with its own impact)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")
-    o.set_defaults(func=cmd_optimize_gait)
+    o.set_defaults(func=cmd_optimize_gait, hzd=None)  # None: the model decides (see optimize_gait)

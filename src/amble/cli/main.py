@@ -21,7 +21,6 @@ from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
-from .equations import cmd_equations
 from .gait import add_parser as add_gait_parser
 from .output import write_output
 
@@ -91,7 +90,10 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--steps must be at least 1 and at most {most}, got {args.steps}")
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
-    s = load_model(args.model)
+    drawn = bool(plot_p or anim_p)
+    s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or args.method == "radau")
+    if out_p and hasattr(s, "full") and any(m.inputs for m in s.modes.values()):
+        s = s.full()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
@@ -143,13 +145,17 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         check_writer(anim_p)
     if not 1 <= args.period <= MAX_PERIOD:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
-    s = load_model(args.model)
+    # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
+    s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True)
     params = parse_sets(args.set)
     guess = _start(s, args.guess, params) if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
     out = lc.to_json()
     if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
         from ..analysis.gait_check import check_gait
+
+        if hasattr(s, "full"):  # the checks read the symbolic model (contact forces, the control law)
+            lc.hybrid_system = s.full()
 
         # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
         gait = lc.trajectory(steps=lc.period)
@@ -192,6 +198,12 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     return out
 
 
+def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
+    from .equations import cmd_equations as run  # SymPy's printers: only for this command
+
+    return run(args)
+
+
 def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
     # options are checked (UsageError, exit 2) in sweep_cli before any file is touched or work starts
     from .sweep import sweep_cli
@@ -210,7 +222,16 @@ EXAMPLES = {
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
+class _Unused:
+    """Stands in for the parser of a command that is not being run: every call is accepted and
+    does nothing (building all seven parsers costs more than a warm limit cycle's search)."""
+
+    def __getattr__(self, name: str) -> Any:
+        return lambda *a, **k: self
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The command-line parser; ``only``: build that command's sub-parser alone (the one being run)."""
     p = _Parser(prog="amble", description="Equation-based modeling and simulation of walking robots.",
                 formatter_class=argparse.RawDescriptionHelpFormatter,
                 epilog="examples:\n  " + "\n  ".join(EXAMPLES.values()))
@@ -218,6 +239,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", parser_class=_Parser, required=True)
 
     def add(name: str, help_: str) -> argparse.ArgumentParser:
+        if only is not None and name != only:
+            return _Unused()  # type: ignore[return-value]
         sp = sub.add_parser(name, help=help_, description=help_, epilog=f"example:\n  {EXAMPLES[name]}",
                             formatter_class=argparse.RawDescriptionHelpFormatter)
         sp.add_argument("--json", action="store_true", help="print a JSON object on stdout")
@@ -317,7 +340,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: list[str]) -> int:
     want_json = "--json" in argv
     try:
-        args = build_parser().parse_args(argv)
+        # only the command named first is built (--help, --version and mistakes get the whole parser)
+        first = argv[0] if argv and argv[0] in EXAMPLES and not {"-h", "--help"} & set(argv) else None
+        args = build_parser(first).parse_args(argv)
         result = args.func(args)
         if args.json:
             print(json.dumps(result, default=_jsonable))

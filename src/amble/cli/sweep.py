@@ -46,7 +46,8 @@ def sweep_cli(args: Any) -> dict[str, Any]:
         raise UsageError(f"--workers must be at least 1, got {args.workers}")
     out = writable_path(args.out, (".csv", ".parquet"), "--out")
     plot = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    system = load_model(args.model)
+    # the compiled model when the index holds it: no SymPy here, nor in workers it is sent to
+    system = load_model(args.model, compiled=True, derivatives=True)
     names = [r[0] for r in ranges]
     if basin_kind:
         known = list(system.state_names(system.mode_names[0]))

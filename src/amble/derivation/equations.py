@@ -183,8 +183,12 @@ def _typeset(name: str, model: Model | None, accent: str) -> str:
     return f"{head}_{{{_sub(sub)}}}" if sub else head
 
 
-def derive(model: Model) -> Equations:
+def derive(model: Model, control: bool = True) -> Equations:
     """Derive ``M``, ``h`` and ``Γ`` of a model from its Lagrangian (no simplification).
+
+    ``control=False`` leaves out the HZD feedback law of a model with virtual constraints (its
+    symbolic derivation is most of the time for RABBIT); ``u`` is then the declared control law
+    without it. An optimisation that treats the inputs as unknowns needs only ``M``, ``h``, ``Γ``, ``B``.
 
     Point masses take the Jacobian route, which needs no derivative of the (large) kinetic
     energy: with ``vᵢ = Jᵢ q̇`` and the convective acceleration ``aᵢ = (∂vᵢ/∂q) q̇``,
@@ -234,7 +238,7 @@ def derive(model: Model) -> Equations:
     if model.derived_placeholders and u.rows:
         subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
         u = u.xreplace(subs)
-    if model.virtual is not None:  # the HZD law, as named intermediate quantities after the tree's
+    if model.virtual is not None and control:  # the HZD law, as named intermediate quantities after the tree's
         defs, Mc, hc = compact if compact is not None else ([], M, h)
         hdefs, u = hzd_law(model, Mc, hc, model.generalized_force, B)
         if model.saturated:

@@ -11,6 +11,15 @@ discovered automatically.
 
 Any error while the file runs is reported as a :class:`~amble.errors.ModelError` of one line that
 names the file and the line of the file where it happened.
+
+:func:`load` returns a new, independent system on every call: adding an actuator, a transition
+or a mode to it changes no other caller's copy. The library module's ``build()`` runs once per
+process; later calls copy its result (containers and amble's own objects are copied, SymPy
+expressions, which are immutable, are shared).
+
+:func:`source_files` and :func:`load_traced` tell the warm start of the command line
+(:mod:`amble.backend.index`) which files a model is made from, so that a compiled model can be
+found again without building the model.
 """
 
 from __future__ import annotations
@@ -19,14 +28,17 @@ import contextlib
 import importlib
 import importlib.util
 import math
+import os
 import pkgutil
 import sys
-import traceback
 from functools import cache, lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ModelError
-from ..modelling.hybrid import HybridSystem
+
+if TYPE_CHECKING:  # the model library is listed and located without SymPy
+    from ..modelling.hybrid import HybridSystem
 
 
 @lru_cache(maxsize=1)
@@ -46,13 +58,112 @@ def names() -> list[str]:
     return list(registry())
 
 
-@cache
 def load(name: str) -> HybridSystem:
-    """Build a model of the library by name (cached per process)."""
+    """A model of the library by name: a new system each call, independent of every other
+    caller's (the module's ``build()`` runs once per process; see the module docstring)."""
+    return _fresh(_built(name), {})
+
+
+@cache
+def _built(name: str) -> HybridSystem:
     reg = registry()
     if name not in reg:
         raise ModelError(f"unknown model {name!r}; available: {', '.join(reg)}")
     return importlib.import_module(f"{__name__}.{reg[name]}").build()
+
+
+def _fresh(obj: Any, memo: dict[int, Any]) -> Any:
+    """A copy of ``obj`` that shares nothing mutable of amble's with it: builtin containers and
+    instances of amble's classes are copied, recursively (references between them keep their
+    shape: a tree's link back to its model points at the copied model); everything else —
+    SymPy expressions, numbers, strings, functions — is immutable or not amble's, and shared."""
+    hit = memo.get(id(obj))
+    if hit is not None:
+        return hit
+    kind = type(obj)
+    if kind is list or kind is set:
+        new: Any = kind()
+        memo[id(obj)] = new
+        (new.extend if kind is list else new.update)(_fresh(v, memo) for v in obj)
+    elif kind is dict:
+        new = {}
+        memo[id(obj)] = new
+        new.update((k, _fresh(v, memo)) for k, v in obj.items())
+    elif kind is tuple:
+        new = tuple(_fresh(v, memo) for v in obj)
+        memo[id(obj)] = new
+    elif kind.__module__.startswith("amble.") and hasattr(obj, "__dict__") and not isinstance(obj, type):
+        new = object.__new__(kind)  # frozen dataclasses too: their fields are set through __dict__
+        memo[id(obj)] = new
+        new.__dict__.update((k, _fresh(v, memo)) for k, v in vars(obj).items())
+    else:
+        return obj
+    return new
+
+
+def source_files(spec: str) -> list[Path]:
+    """The files a model is built from, as far as they are known before building it: every
+    module of the library for a library model (one may extend another), the file itself for
+    ``path.py[:callable]`` (what it reads while it runs is found by :func:`load_traced`)."""
+    if is_file_spec(spec):
+        return [Path(_split_spec(spec)[0]).resolve()]
+    return sorted(f for d in __path__ for f in Path(d).resolve().glob("*.py"))
+
+
+def load_traced(spec: str) -> tuple[HybridSystem, list[Path]]:
+    """The system of ``spec`` (a library model or a model file) and the files outside amble and
+    the Python installation that were read while it was built: the modules a model file imports
+    from its own directory, the data (a URDF, a table) it opens."""
+    if not is_file_spec(spec):
+        return load(spec), []
+    before = set(sys.modules)
+    opened: set[str] = set()
+    _install_audit()
+    _TRACING.append(opened)
+    try:
+        system = load_file(spec)
+    finally:
+        _TRACING.remove(opened)
+    for name in set(sys.modules) - before:
+        f = getattr(sys.modules.get(name), "__file__", None)
+        if f:
+            opened.add(f)
+    return system, sorted({p for f in opened for p in [_outside(f)] if p is not None})
+
+
+#: the sets of paths being collected by :func:`load_traced` (the audit hook adds to each)
+_TRACING: list[set[str]] = []
+_AUDIT: list[bool] = []
+
+
+def _install_audit() -> None:
+    if not _AUDIT:
+        _AUDIT.append(True)
+        sys.addaudithook(_on_audit)  # once per process; it does nothing while no load is traced
+
+
+def _on_audit(event: str, args: tuple) -> None:
+    if event == "open" and _TRACING:
+        path, mode = args[0], args[1] if len(args) > 1 else "r"
+        if isinstance(path, (str, os.PathLike)) and not any(c in str(mode or "r") for c in "wax+"):
+            for s in _TRACING:
+                s.add(os.fspath(path))
+
+
+def _outside(path: str) -> Path | None:
+    """``path`` resolved, if it is a regular file outside amble, the Python installation and
+    byte-code caches; else ``None``."""
+    try:
+        p = Path(path).resolve()
+        if not p.is_file():
+            return None
+    except (OSError, ValueError):
+        return None
+    skip = {Path(__file__).resolve().parents[1], *(Path(d).resolve() for d in
+            {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix})}
+    if "__pycache__" in p.parts or any(p.is_relative_to(d) for d in skip):
+        return None
+    return p
 
 
 def is_file_spec(spec: str) -> bool:
@@ -91,12 +202,16 @@ def load_file(spec: str) -> HybridSystem:
     except Exception as e:  # anything the user's code raises: one line, with its place in the file
         first = str(e).splitlines()[0] if str(e) else ""
         raise ModelError(f"{_where(e, path)}{type(e).__name__}: {first}") from e
+    from ..modelling.hybrid import HybridSystem
+
     if not isinstance(system, HybridSystem):
         raise ModelError(f"{spec}: returned {type(system).__name__}, not a HybridSystem")
     return system
 
 
 def _system_of(module, path_text: str, attr: str):
+    from ..modelling.hybrid import HybridSystem
+
     if attr:
         if not hasattr(module, attr):
             raise ModelError(f"{path_text}: defines no {attr!r}")
@@ -120,6 +235,8 @@ def _call(fn, what: str):
 
 def _where(e: BaseException, path: Path) -> str:
     """``file:line: `` of the innermost frame of the traceback that lies in ``path``."""
+    import traceback
+
     target = str(path.resolve())
     line = None
     for frame in traceback.extract_tb(e.__traceback__):

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME
+from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
 from ..backend.kernels import Kernels
 from ..errors import StateError
 
@@ -219,18 +219,21 @@ _AT_EVENT = (CODE["STEPS_DONE"], CODE["TERMINAL"], CODE["MAX_EVENTS"])
 
 def _sensitivity_buffer(k: Kernels, nx0: int, params: bool) -> np.ndarray:
     """``S = [I 0]`` (the initial state's own columns), ``dτ = 0`` and the numbers of state and
-    parameter columns carried, laid out as sensitivity.h reads it."""
-    sens = np.zeros((k.nx_max + 1) * k.sc + 2)
-    S = sens[: k.nx_max * k.sc].reshape(k.nx_max, k.sc)
+    parameter columns carried, laid out by :func:`amble.backend.abi.sens_layout`."""
+    lay = sens_layout(k.nx_max, k.sc)
+    sens = np.zeros(lay["SIZE"])
+    S = sens[lay["S"] : lay["S"] + k.nx_max * k.sc].reshape(k.nx_max, k.sc)
     S[np.arange(nx0), np.arange(nx0)] = 1.0
-    sens[-2], sens[-1] = nx0, len(k.meta["params"]) if params else 0
+    sens[lay["NCS"]], sens[lay["NCP"]] = nx0, len(k.meta["params"]) if params else 0
     return sens
 
 
 def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) -> Sensitivity:
-    nxm, sc, npar = k.nx_max, k.sc, int(sens[-1])
-    S = sens[: nxm * sc].reshape(nxm, sc)[: r.x.size]
-    tau = sens[nxm * sc : nxm * sc + sc]
+    nxm, sc = k.nx_max, k.sc
+    lay = sens_layout(nxm, sc)
+    npar = int(sens[lay["NCP"]])
+    S = sens[lay["S"] : lay["S"] + nxm * sc].reshape(nxm, sc)[: r.x.size]
+    tau = sens[lay["TAU"] : lay["TAU"] + sc]
     cols = np.r_[np.arange(nx0), nxm + np.arange(npar)]
     S, tau = S[:, cols], tau[cols]
     if r.code in _AT_EVENT:
@@ -245,17 +248,21 @@ def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) 
 
 
 def walk_many(k: Kernels, p: np.ndarray, mode: int, x0: np.ndarray, xref: np.ndarray, *, steps: int,
-              check_every: int, tol: float, opts: Options = Options()) -> dict[str, Any]:
+              check_every: int, tol: float, opts: Options = Options(), threads: int = 1) -> dict[str, Any]:
     """Walk every row of ``x0`` from t = 0 for up to ``steps`` footfalls in one compiled call (no
     recording, the GIL released): in runs of ``check_every`` footfalls, each started like
     :func:`run` from the previous one's final state, until ``max |x − xref| < tol``. Returns per
     walk ``code``, ``status`` (as :attr:`Run.status`), ``steps``, ``distance`` (NaN if no run
     completed) and the final ``x`` — what a loop over :func:`run` gives, without its Python cost
-    per walk (which kept two threads of basin cells at about 1.2× one)."""
+    per walk (which kept two threads of basin cells at about 1.2× one). ``threads``: walk the rows
+    on this many threads of this process, which share them row by row (results do not depend
+    on it)."""
     opt = opts._opt.copy()
     opt[_OP_TEND] = math.inf
-    out = k.walk_batch(mode, x0, p, opt, opts._iopt, xref, steps, check_every, tol)
-    out["status"] = [outcome(k, int(c), int(i)) for c, i in zip(out["code"], out["info"])]
+    out = k.walk_batch(mode, x0, p, opt, opts._iopt, xref, steps, check_every, tol, threads=threads)
+    ok = CODE["STEPS_DONE"]
+    done = outcome(k, ok, -1)
+    out["status"] = [done if c == ok else outcome(k, c, i) for c, i in zip(out["code"].tolist(), out["info"].tolist())]
     return out
 
 

@@ -14,11 +14,8 @@ import weakref
 from typing import Any
 
 import numpy as np
-import sympy as sp
 
-from ..derivation.equations import derive
 from ..errors import AmbleError
-from ..modelling.geometry import t as _t
 
 Trajectory = Any  # a :class:`~amble.simulation.trajectory.Trajectory` (which imports this module)
 
@@ -29,6 +26,11 @@ def _mode_functions(model: Any) -> tuple[Any, Any]:
     """NumPy functions ``(u, ω)`` of ``(t, q..., q̇..., params...)`` for one mode (cached)."""
     hit = _FUNCS.get(model)
     if hit is None:
+        import sympy as sp  # SymPy only for a run with inputs: a passive run imports none
+
+        from ..derivation.equations import derive
+        from ..modelling.geometry import t as _t
+
         eq = derive(model)
         args = [_t, *model.q, *model.qd, *model.params]
         u = list(eq.u) if eq.u is not None else []
@@ -124,6 +126,8 @@ def cost_of_transport(traj: Trajectory) -> float:
     hip = getattr(system, "hip", None)
     if hip is None:
         raise AmbleError("cost of transport needs a walker with a hip point")
+    import sympy as sp
+
     params = traj.parameters
     model = system.modes[traj.mode_names[0]]
     subs = {s: params[str(s)] for s in model.params}

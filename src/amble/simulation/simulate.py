@@ -10,18 +10,21 @@ import dataclasses
 import math
 import numbers
 import operator
+import string
 from collections.abc import Mapping, Sequence
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.abi import CODE, CTX
 from ..backend.kernels import Kernels, build
 from ..errors import ParameterError, StateError
-from ..modelling.hybrid import HybridSystem
 from .engine import RECORD_BUDGET, Options, Run, run
-from .trajectory import Event, Trajectory
+from .trajectory import Event, Events, Trajectory
+
+if TYPE_CHECKING:
+    from ..modelling.hybrid import HybridSystem
 
 
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
@@ -72,7 +75,7 @@ def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, 
         raise StateError(
             f"initial state has {x.size} values, mode {mode!r} needs {len(names)}: {', '.join(names)}"
         )
-    if not np.all(np.isfinite(x)):
+    if not np.isfinite(x).all():
         raise StateError(f"initial state is not finite: {x.tolist()}")
     return mi, x
 
@@ -203,19 +206,13 @@ def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
     meta = k.meta
     trs = meta["transitions"]
     rec = r.recorded
-    # per transition once: its names and the state lengths on either side; an event's states are
-    # views of the run's own event rows (about a microsecond per footfall less than copies)
+    # per transition once: its names and the state lengths on either side; the Event objects are
+    # made when first read (about half a microsecond per footfall, often never needed)
     modes, nx = meta["modes"], meta["nx"]
     kinds = [(tr["name"], tr["source"], tr["target"], nx[modes.index(tr["source"])], nx[modes.index(tr["target"])])
              for tr in trs]
-    events = []
-    if len(rec.get("et", ())):
-        nxm = k.nx_max
-        pres, posts = list(rec["epre"]), list(rec["epost"])  # row views, made in C
-        for t, tr, pre, post in zip(rec["et"].tolist(), rec["etr"].tolist(), pres, posts):
-            name, source, target, ns, nt = kinds[tr]
-            events.append(Event(t, name, source, target, pre if ns == nxm else pre[:ns],
-                                post if nt == nxm else post[:nt]))
+    events: Sequence[Event] = (Events(rec["et"], rec["etr"], rec["epre"], rec["epost"], kinds, k.nx_max)
+                               if len(rec.get("et", ())) else [])
     return Trajectory(t=rec["t"], mode=rec["mode"], x=rec["x"], events=events, status=r.status,
                       message=_message(r, opts, trs, meta.get("switches", [])), steps=r.steps, params=p,
                       kernels=k, final_state=r.x, final_mode=meta["modes"][r.mode])
@@ -243,16 +240,26 @@ _MESSAGES = {
 }
 
 
+#: Status name by code, and the fields each message template reads (parsed once).
+_NAMES = {c: n for n, c in CODE.items()}
+_FIELDS = {name: {f for _, f, _, _ in string.Formatter().parse(text) if f} for name, text in _MESSAGES.items()}
+
+
 def _message(r: Run, opts: Options, trs: list, switches: list) -> str:
-    name = next(n for n, c in CODE.items() if c == r.code)
+    name = _NAMES.get(r.code, "")
     template = _MESSAGES.get(name, "stopped at t = {t:.6g} s")
-    return template.format(t=r.t, steps=r.steps, events=r.events, x=r.x.tolist(), max_step_time=opts.max_step_time,
-                           zeno_events=opts.zeno_events, zeno_dt=opts.zeno_dt,
-                           max_steps_between_events=opts.max_steps_between_events,
-                           max_integrator_steps=opts.max_integrator_steps, surface=r.info,
-                           surface_expr=_surface(r, switches),
-                           transition=trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "",
-                           stiff=_stiff_hint(r, opts))
+    # only the fields this template reads are worked out (the state as a list, the stiffness
+    # hint: microseconds on every call of simulate() otherwise)
+    fields = {
+        "t": lambda: r.t, "steps": lambda: r.steps, "events": lambda: r.events, "x": lambda: r.x.tolist(),
+        "max_step_time": lambda: opts.max_step_time, "zeno_events": lambda: opts.zeno_events,
+        "zeno_dt": lambda: opts.zeno_dt, "max_steps_between_events": lambda: opts.max_steps_between_events,
+        "max_integrator_steps": lambda: opts.max_integrator_steps, "surface": lambda: r.info,
+        "surface_expr": lambda: _surface(r, switches),
+        "transition": lambda: trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "",
+        "stiff": lambda: _stiff_hint(r, opts),
+    }
+    return template.format(**{f: fields[f]() for f in _FIELDS.get(name, ("t",))})
 
 
 def _stiff_hint(r: Run, opts: Options) -> str:

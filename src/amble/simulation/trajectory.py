@@ -9,6 +9,7 @@ accumulates the footholds so a walk can be drawn on its slope.
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -35,6 +36,49 @@ class Event:
     x_post: np.ndarray
 
 
+class Events(Sequence):
+    """The events of a run, in time order: a read-only sequence of :class:`Event`, made from the
+    run's event rows when first read (a walk of hundreds of footfalls whose events nobody reads
+    pays nothing for them). ``kinds[tr]``: transition ``tr``'s name, source and target mode and
+    their state lengths; ``nxm``: the padded row length."""
+
+    __slots__ = ("_t", "_tr", "_pre", "_post", "_kinds", "_nxm", "_items")
+
+    def __init__(self, t: np.ndarray, tr: np.ndarray, pre: np.ndarray, post: np.ndarray,
+                 kinds: Sequence[tuple[str, str, str, int, int]], nxm: int) -> None:
+        self._t, self._tr, self._pre, self._post, self._kinds, self._nxm = t, tr, pre, post, kinds, nxm
+        self._items: list[Event] | None = None
+
+    def _list(self) -> list[Event]:
+        if self._items is None:
+            nxm, kinds, items = self._nxm, self._kinds, []
+            # an event's states are views of the run's own event rows (made in C, no copies)
+            for t, tr, pre, post in zip(self._t.tolist(), self._tr.tolist(), list(self._pre), list(self._post)):
+                name, source, target, ns, nt = kinds[tr]
+                items.append(Event(t, name, source, target, pre if ns == nxm else pre[:ns],
+                                   post if nt == nxm else post[:nt]))
+            self._items = items
+        return self._items
+
+    def __len__(self) -> int:
+        return len(self._t) if self._items is None else len(self._items)
+
+    def __getitem__(self, i: Any) -> Any:
+        return self._list()[i]
+
+    def __iter__(self) -> Iterator[Event]:
+        return iter(self._list())
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    def __repr__(self) -> str:
+        return repr(self._list())
+
+    def __reduce__(self) -> tuple:  # pickles (Dask, multiprocessing) as a plain list
+        return (list, (self._list(),))
+
+
 @dataclass
 class Trajectory:
     """A simulated run. ``status`` is ``completed`` (all steps done), ``end_time``, ``fell``,
@@ -43,7 +87,7 @@ class Trajectory:
     t: np.ndarray
     mode: np.ndarray
     x: np.ndarray
-    events: list[Event]
+    events: Sequence[Event]
     status: str
     message: str
     steps: int

@@ -22,7 +22,7 @@
  *   void kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel);
  *   AMBLE_PARAMS(p): replaces the caller's NPARAM parameters p by the array of NPARAM + NHOIST
  *     values that every kernel reads (parameters, then their parameter-only subexpressions);
- *     each exported entry point below starts with it
+ *     each exported entry point that calls kernels starts with it (here and in batch.h)
  */
 #include <stdint.h>
 
@@ -138,7 +138,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         if (ev_k < 0) {
             if (sens) {
                 double y1[NXMAX];
-                if ((st = sens_advance(mode, p, sens_cols(sens), t, s.h, s.y_old, sens, y1))) { status = st; break; }
+                if ((st = sens_advance(mode, p, sens_cols(sens), t, s.h, s.y_old, sens + SENS_S, y1))) { status = st; break; }
             }
             t = t_new;
             for (int i = 0; i < s.n; ++i) { s.y_old[i] = s.y[i]; s.f_old[i] = s.f[i]; }

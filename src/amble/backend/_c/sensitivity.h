@@ -14,15 +14,14 @@
  * pre-event value (f⁺ = f⁻) and records dτ.
  *
  * Buffer (caller-owned, persists across calls): S as NXMAX rows of SC = NXMAX + NPARAM columns
- * (state columns 0 … nx0−1, parameter j at NXMAX + j), then one row dτ of the last transition.
+ * (state columns 0 … nx0−1, parameter j at NXMAX + j), then one row dτ of the last transition,
+ * then the numbers of state and parameter columns carried; its offsets SENS_S, SENS_TAU,
+ * SENS_NCS, SENS_NCP and SENS_SIZE come from the table in amble/backend/abi.py.
  * Needs from the including unit: dop853.h, events.h, rhs_jac, surfaces_grad, reset_jac.
  */
 #ifndef AMBLE_SENSITIVITY_H
 #define AMBLE_SENSITIVITY_H
 
-#define SENS_TAU (NXMAX * SC)
-#define SENS_NCS (SENS_TAU + SC) /* buffer entry: state columns carried (the initial state's size) */
-#define SENS_NCP (SENS_NCS + 1)  /* buffer entry: parameter columns carried (0 or NPARAM) */
 
 /* The columns a run carries: 0 … ncs−1 (initial state), NXMAX … NXMAX+ncp−1 (parameters). */
 typedef struct { int ncs, ncp; } Cols;
@@ -94,7 +93,7 @@ static int sens_advance(int mode, const double *p, Cols cl, double t0, double h,
 static int sens_to_event(const Dop *s, int mode, const double *p, double t0, const double *y0, double t_ev,
                          const double *x_ev, int is_switch, double *sens, double *fm) {
     const Cols cl = sens_cols(sens);
-    double *S = sens;
+    double *S = sens + SENS_S;
     const int n = MODE_NX[mode];
     const double span = t_ev - t0;
     double delta = fmax(1e-6 * span, 1e-9 * fmax(1.0, fabs(t_ev)));
@@ -132,7 +131,7 @@ static int sens_jump(int mode, int k, int tr, int target, double t_ev, const dou
     double G[NTR1 * SC], gd[NTR1], dtau[SC];
     surfaces_grad(mode, t_ev, x_ev, p, G);
     surfaces_dot(mode, t_ev, x_ev, fm, p, gd);
-    double *S = sens;
+    double *S = sens + SENS_S;
     const double *g = G + k * SC;
     if (!(fabs(gd[k]) > 0.0)) { /* grazing: the event time does not depend smoothly on the data */
         for (int e = 0; e < SENS_NCS; ++e) sens[e] = NAN;

@@ -124,8 +124,8 @@
   api.playing = () => playing;
   api.duration = duration;
 
-  if (!hashBool('ui', true)) {          // bare canvas, e.g. for figures
-    for (const id of ['bar', 'title', 'hint']) $(id).style.display = 'none';
+  if (!hashBool('ui', true)) {          // bare canvas, e.g. for figures: no overlay hides the robot
+    for (const id of ['bar', 'title', 'hint', 'series']) $(id).style.display = 'none';
   }
   speed = hashNum('speed', 1);
   const listed = [...speedSel.options].find((o) => parseFloat(o.value) === speed);
