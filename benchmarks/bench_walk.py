@@ -10,6 +10,7 @@ m = 5 kg, a = b = 0.5 m, g = 9.81 m/s², slope 0.0525 rad; amble's compass-gait 
   — the whole walk (integration, event location, resets) in one compiled call; timed around the
   Python call (kernels already built, one warm-up call).
 * ``amble.simulate(...)``: the user-facing call that also records the sampled trajectory.
+* every library model before and after the lean right-hand side (:func:`library_models`).
 * C floor (:mod:`benchmarks.peers.floor`): the leanest hand-written C loop (same DOP853 and
   event location, Drake's equations written out by hand), timed around its ctypes call. amble
   and the floor are timed interleaved, repeat by repeat, so machine load hits both alike.
@@ -25,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import statistics
 import time
 from pathlib import Path
@@ -185,6 +187,77 @@ def humanoid(quick: bool) -> tuple[str, list[Goal]]:
     return md, [goal]
 
 
+def _unhoisted(system: Any) -> Any:
+    """The system's kernels generated with ``generate(..., hoist_params=False)`` (parameter-only
+    subexpressions recomputed at every use, M solved as if dense), cached beside the regular
+    library under a key of their own."""
+    import hashlib
+    import json
+
+    from amble.backend import cache
+    from amble.backend.codegen import generate
+    from amble.backend.kernels import Kernels
+
+    key = hashlib.sha256(f"{cache.structure_key(system)}:no-hoist-dense".encode()).hexdigest()[:24]
+    d = cache.cache_dir()
+    hit = cache.cached(d, key)
+    if hit is None:
+        src, meta = generate(system, hoist_params=False)
+        so, digest = cache._compile(src, key, d)
+        meta = {**meta, "library": so.name, "library_sha256": digest}
+        cache._write_atomic(d / f"{key}.json", json.dumps(meta).encode())
+        hit = (so, meta)
+    return Kernels(*hit)
+
+
+def library_models(quick: bool) -> tuple[str, list[Goal]]:
+    """Every library model on the fast path from its default start, before and after the lean
+    right-hand side (hoisted parameter-only subexpressions, the sparse solve), interleaved run by
+    run (and the C floor, a compass gait)."""
+    from amble.backend.kernels import build
+    from amble.models import load, names
+    from amble.simulation.engine import Options, run
+    from amble.simulation.simulate import initial_state, parameter_vector
+    from benchmarks.peers import compass_scipy, floor
+
+    steps, reps = (3, 3) if quick else (10, 9)
+    rows = []
+    for name in names():
+        print(f"walk: library model {name} ...", flush=True)
+        system = load(name)
+        k_new, k_old = build(system), _unhoisted(system)
+        p = parameter_vector(k_new, None)
+        mi, x = initial_state(system, k_new, None, None)
+        opts = Options(max_step_time=system.max_step_time)
+        r = run(k_new, p, mi, x, steps=steps, opts=opts)  # warm-up, and how far it walks
+        run(k_old, p, mi, x, steps=steps, opts=opts)
+        n = max(r.steps, 1)
+        walls: dict[str, list[float]] = {"old": [], "new": []}
+        for _ in range(reps):
+            for tag, kk in (("old", k_old), ("new", k_new)):
+                t0 = time.perf_counter()
+                run(kk, p, mi, x, steps=steps, opts=opts)
+                walls[tag].append((time.perf_counter() - t0) / n)
+        old, new = Stats.of(walls["old"]), Stats.of(walls["new"])
+        found = re.search(r"#define NHOIST (\d+)", k_new.path.with_suffix(".c").read_text())
+        nh = found.group(1) if found else "?"
+        rows.append([name, f"{r.steps} ({r.status})", nh, us(old.median), us(new.median),
+                     f"{new.median / old.median:.2f}×", f"{new.min / old.min:.2f}×"])
+    fl = [floor.simulate(compass_scipy.LIMIT_CYCLE_X0, 200, 1e-10, 1e-10)["call_wall_s"] / 200 for _ in range(reps)]
+    rows.append(["C floor (compass gait, Drake's parameters, 200 steps, 1e-10)", "200", "—", "—",
+                 us(statistics.median(fl)), "—", "—"])
+    md = (f"Each library model from its default start, {steps} walking steps per run on the fast path at its "
+          f"default tolerances, µs per walking step, medians of {reps} runs. *before* is the model's library "
+          "generated with `generate(system, hoist_params=False)`: parameter-only subexpressions recomputed at "
+          "every use and M solved as if dense, in the natural order — the right-hand side as it was before "
+          "both (the nested sin² + cos² pairing of `backend/trig.py` is in both); *after* is the default "
+          "library. The two are timed alternately run by run. *hoisted* is the number of values in the "
+          "parameter prelude.\n\n"
+          + table(["model", "steps walked", "hoisted", "µs/step before", "µs/step after",
+                   "after ÷ before (medians)", "(minima)"], rows))
+    return md, []
+
+
 def work_precision(k: Any, p: np.ndarray, x0: np.ndarray, steps: int, ref_x: np.ndarray, quick: bool) -> str:
     """Error after ``steps`` steps against time per step, for amble, the C floor and SciPy (Drake
     when importable), each at a range of tolerances; writes :data:`WP_PLOT`."""
@@ -337,10 +410,13 @@ def run(quick: bool = False) -> Section:
     rec_md, rec_goals = recording(system, k, p, x0, quick)
     print("walk: humanoid-3d ...", flush=True)
     hum_md, hum_goals = humanoid(quick)
+    print("walk: library models ...", flush=True)
+    lib_md, lib_goals = library_models(quick)
     print("walk: work–precision ...", flush=True)
     wp_md = work_precision(k, p, x0, steps, ref_x, quick)
-    goals += rec_goals + hum_goals
+    goals += rec_goals + hum_goals + lib_goals
     md += ["#### Recording and the command line", "", rec_md, "", "#### humanoid-3d", "", hum_md, "",
+           "#### Every library model: before and after the lean right-hand side", "", lib_md, "",
            "#### Work–precision", "", wp_md, ""]
     data = {"steps": steps, "refs_diff": refs_diff, "ref_self_error": ref_scipy["self_error"],
             "results": results}

@@ -16,6 +16,13 @@ def test_pairs_collapse():
     assert pythagoras([e]) == [l * sp.cos(b) ** 2]
 
 
+def test_nested_pairs_collapse_to_the_end():
+    # a direction with two angles (|R3(a, b)|² = 1): one pair's rest pairs with another term
+    e = l * sp.sin(a) ** 2 * sp.sin(b) ** 2 + l * sp.sin(b) ** 2 * sp.cos(a) ** 2 + l * sp.cos(b) ** 2
+    assert pythagoras([e]) == [l]
+    assert pythagoras([m * e + q]) == [m * l + q]
+
+
 def test_non_pairs_are_left_alone():
     for e in (sp.sin(q) ** 2 + sp.cos(r) ** 2, 2 * sp.sin(q) ** 2 + sp.cos(q) ** 2, sp.sin(q) ** 2 * sp.cos(q) ** 2):
         assert pythagoras([e]) == [e]

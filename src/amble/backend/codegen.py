@@ -13,6 +13,7 @@ the right-hand side is inlined into the integrator.
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import sympy as sp
 
@@ -27,30 +28,41 @@ from .codegen_support import Printer as _Printer
 from .codegen_support import block as _block
 from .codegen_support import bool_expr as _bool_block
 from .codegen_support import symbol_names as _names
+from .hoist import Hoister
+from .ldl import UNROLL_MAX, constant_pivots, ldl_order, ldl_solve_code
 from .trig import pythagoras
 from .variational_codegen import derivative_kernels, derivative_stubs
 
 
 def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, nm: dict[sp.Symbol, str],
-                   prelude: str) -> str:
+                   prelude: str, hoist: Hoister) -> str:
     """``mh_k`` (the lower triangle of M, h and Γ — emitted once: for a large tree it is most of
     the unit and of the compile time), and the two kernels that use it: ``rhs_k`` (q̈ = M⁻¹ (Γ − h)
-    by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display)."""
+    by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display). Parameter-only
+    subexpressions are read from the prelude (``hoist``), and so are the pivots and multipliers of
+    a leading block of M that depends on parameters only (the compass gait's M₀₀)."""
     tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)] + [f"h[{i}]" for i in range(n)]
     tg += [f"G[{i}]" for i in range(n)]
     ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
     ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
+    low = lambda i, j: ex[max(i, j) * (max(i, j) + 1) // 2 + min(i, j)]  # M[i, j] of the lower triangle
+    nonzero = {(i, j) for i in range(n) for j in range(i) if low(i, j) != 0}
+    if not hoist.enabled:  # the code of before (benchmarks): a dense solve in the natural order
+        nonzero = {(i, j) for i in range(n) for j in range(i)}
+    order = ldl_order(n, nonzero) if n <= UNROLL_MAX else list(range(n))
+    known = constant_pivots(sp.Matrix(n, n, lambda i, j: low(order[i], order[j])), nm, hoist)
+    ex = hoist(ex)
     # small kernels are inlined into both callers (a call costs as much as their body); large ones
     # are compiled once, which is the point of emitting them once
     inline = "AMBLE_INLINE " if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
     sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
     out = [f"static {inline}void mh_{k}{sig} {{\n",
-           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n"]
+           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, {**nm, **hoist.names}, prelude=prelude), "}\n"]
     out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
             f"    double M[{n * n}], h[{n}], f[{n}];\n",
             f"    mh_{k}(t, x, p, M, h, f);\n",
             f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
-            ldl_solve_code(n, "M", "f"),
+            ldl_solve_code(n, "M", "f", known=known, order=order, nonzero=nonzero),
             f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
             "    return 0;\n}\n"]
     out += [f"static void dynamics_{k}{sig} {{\n",
@@ -64,57 +76,13 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
 #: Largest ``mh_k`` (operations of M, h, Γ) that is forced inline into ``rhs_k`` and ``dynamics_k``.
 INLINE_OPS = 400
 
-#: Largest system whose LDLᵀ solve is written out statement by statement; larger ones call the
-#: loop in ``amble_core.h`` (unrolled code grows as n³/6 and so does its compile time).
-UNROLL_MAX = 12
-
-
-def ldl_solve_code(n: int, a: str, b: str, indent: str = "    ") -> str:
-    """C statements solving ``a x = b`` in place for a symmetric positive definite ``a`` (row-major
-    n × n, lower triangle read and overwritten by the unit lower factor L; ``b`` overwritten by x),
-    returning ``AMBLE_ERR_SINGULAR_MASS`` from the enclosing function if a pivot is not positive or
-    the pivots spread by more than 1e14 (the same test as ``amble_ldl_solve``: cond(A) is at least
-    max D / min D). LDLᵀ needs no square root; up to :data:`UNROLL_MAX` the loops are unrolled so
-    every index is a constant."""
-    if n > UNROLL_MAX:
-        return f"{indent}if (amble_ldl_solve({n}, {a}, {b})) return AMBLE_ERR_SINGULAR_MASS;\n"
-    A = lambda i, j: f"{a}[{i * n + j}]"
-    L: list[str] = []
-    w = L.append
-    w(f"{indent}{{\n")
-    ind = indent + "    "
-    for j in range(n):
-        # u_k = L[j,k] D_k (k < j) are reused by every row below j
-        for k in range(j):
-            w(f"{ind}const double u{j}_{k} = {A(j, k)} * d{k};")
-        s = " - ".join([A(j, j)] + [f"{A(j, k)} * u{j}_{k}" for k in range(j)])
-        w(f"{ind}const double d{j} = {s};")
-        w(f"{ind}if (!(d{j} > 0.0)) return AMBLE_ERR_SINGULAR_MASS;")
-        w(f"{ind}const double r{j} = 1.0 / d{j};")  # one division per pivot, none in the solve
-        for i in range(j + 1, n):
-            s = " - ".join([A(i, j)] + [f"{A(i, k)} * u{j}_{k}" for k in range(j)])
-            w(f"{ind}{A(i, j)} = ({s}) * r{j};")
-    if n > 1:
-        w(f"{ind}double dmin = d0, dmax = d0;")
-        for j in range(1, n):
-            # comparisons, not fmin/fmax: those are library calls at -O2 (NaN rules)
-            w(f"{ind}if (d{j} < dmin) dmin = d{j};")
-            w(f"{ind}if (d{j} > dmax) dmax = d{j};")
-        w(f"{ind}if (dmax > 1e14 * dmin) return AMBLE_ERR_SINGULAR_MASS;")
-    for i in range(1, n):  # L y = b
-        w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(i, k)} * {b}[{k}]" for k in range(i)) + ";")
-    for i in range(n):  # D z = y
-        w(f"{ind}{b}[{i}] *= r{i};")
-    for i in range(n - 2, -1, -1):  # Lᵀ x = z
-        w(f"{ind}{b}[{i}] -= " + " + ".join(f"{A(k, i)} * {b}[{k}]" for k in range(i + 1, n)) + ";")
-    w(f"{indent}}}")
-    return "\n".join(L) + "\n"
-
-
-def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict]:
+def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool = True) -> tuple[str, dict]:
     """Generate the C source of a system; returns (source, metadata for the loader). With
     ``derivatives`` also the derivative kernels of sensitivity runs and of the implicit
-    integrator (several times longer than the rest: built only when asked for)."""
+    integrator (several times longer than the rest: built only when asked for).
+    ``hoist_params=False`` recomputes parameter-only subexpressions at every use instead of once
+    per call (:mod:`amble.backend.hoist`) and solves with M as if it were dense, in the natural
+    order (:mod:`amble.backend.ldl`): for benchmarks of what those save."""
     params = list(system.parameters)
     modes = {name: ModeInfo(m, derive(m), i) for i, (name, m) in enumerate(system.modes.items())}
     points = system.point_names
@@ -131,6 +99,12 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
     for name in modes:
         sw0.append(acc)
         acc += len(switches[name])
+
+    hoist = Hoister({s for mi in modes.values() for s in mi.model.params}, enabled=hoist_params)
+
+    def blk(targets: list[str], exprs: list, nm: dict, prelude: str = "") -> str:
+        ex = hoist(exprs)
+        return _block(targets, ex, {**nm, **hoist.names}, prelude=prelude)
 
     out: list[str] = []
     w = out.append
@@ -162,14 +136,13 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
         # a rigid-body tree's M and h come with their intermediate quantities (Equations.compact)
         defs, eqM, eqh = eq.compact if eq.compact is not None else ((), eq.M, eq.h)
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
-        pr = _Printer(nm)
-        prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
-        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude))
+        prelude = _defs_code(defs, nm, hoist)
+        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude, hoist))
         # guards of this mode's transitions
         trs = trs_by_mode[name]
         w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")
         w("    (void)t; (void)x; (void)p; (void)g;\n")
-        w(_block([f"g[{i}]" for i in range(len(trs))], [sp.sympify(tr.guard.expr) for tr in trs], nm))
+        w(blk([f"g[{i}]" for i in range(len(trs))], [sp.sympify(tr.guard.expr) for tr in trs], nm))
         w("}\n")
         # time derivatives of the guards along the flow, ġ = ∇ₓg · ẋ + ∂g/∂t (ẋ given as dx)
         xs = [*m.q, *m.qd]
@@ -182,18 +155,18 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
             gdot.append(m.diff(ge, t) + sum((m.diff(ge, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)))
         w(f"static void guards_dot_{k}(double t, const double *x, const double *dx, const double *p, double *g) {{\n")
         w("    (void)t; (void)x; (void)dx; (void)p; (void)g;\n")
-        w(_block([f"g[{i}]" for i in range(len(trs))], gdot, nm_d))
+        w(blk([f"g[{i}]" for i in range(len(trs))], gdot, nm_d))
         w("}\n")
         # switching surfaces of the right-hand side and their rates (events without a reset)
         sws = switches[name]
         w(f"static void switches_{k}(double t, const double *x, const double *p, double *s) {{\n")
         w("    (void)t; (void)x; (void)p; (void)s;\n")
-        w(_block([f"s[{i}]" for i in range(len(sws))], sws, nm))
+        w(blk([f"s[{i}]" for i in range(len(sws))], sws, nm))
         w("}\n")
         sdot = [sp.diff(e, t) + sum((sp.diff(e, xj) * dj for xj, dj in zip(xs, dxs)), sp.Integer(0)) for e in sws]
         w(f"static void switches_dot_{k}(double t, const double *x, const double *dx, const double *p, double *s) {{\n")
         w("    (void)t; (void)x; (void)dx; (void)p; (void)s;\n")
-        w(_block([f"s[{i}]" for i in range(len(sws))], sdot, nm_d))
+        w(blk([f"s[{i}]" for i in range(len(sws))], sdot, nm_d))
         w("}\n")
         # energies
         if eq.K is not None:
@@ -202,7 +175,7 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
             e_ex = [eq.energy, sp.Integer(0)]
         w(f"static void energy_{k}(double t, const double *x, const double *p, double *out) {{\n")
         w("    (void)t; (void)p;\n")
-        w(_block(["out[0]", "out[1]"], e_ex, nm))
+        w(blk(["out[0]", "out[1]"], e_ex, nm))
         w("}\n")
         # kinematics of named points (3 components each; 2D models have y = 0)
         tg, ex = [], []
@@ -219,17 +192,17 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
         w(f"static void kinematics_{k}(double t, const double *x, const double *p, double *pos, double *vel) {{\n")
         w("    (void)t; (void)x; (void)p;\n")
         w(f"    for (int i = 0; i < {3 * len(points)}; ++i) {{ pos[i] = NAN; vel[i] = NAN; }}\n")
-        w(_block(tg, ex, nm))
+        w(blk(tg, ex, nm))
         w("}\n\n")
 
     # transitions: enabling conditions and resets
     for i, tr in enumerate(order):
         src = modes[tr.source]
         nm = _names(src.model, params)
-        cond = "1" if tr.guard.enabled is None else _bool_block(sp.sympify(tr.guard.enabled), nm)
+        cond = "1" if tr.guard.enabled is None else _bool_block(hoist.one(tr.guard.enabled), {**nm, **hoist.names})
         w(f"static int enabled_{i}(double t, const double *x, const double *p) {{\n")
         w(f"    (void)t; (void)x; (void)p;\n    return ({cond}) ? 1 : 0;\n}}\n")
-        w(_reset_code(i, tr, src, modes, nm, params))
+        w(_reset_code(i, tr, src, modes, nm, params, hoist))
 
     # derivatives for sensitivity runs and the implicit integrator, or stubs (variational_codegen)
     if derivatives:
@@ -270,6 +243,8 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
              "enabled_{}(t, x, p)", [tr.name for tr in order], "tr")
     dispatch("reset(int tr, double t, const double *x, const double *p, double *xout, int *target)", "int",
              "reset_{}(t, x, p, xout, target)", [tr.name for tr in order], "tr")
+    pnames = {s: f"p[{params.index(str(s))}]" for s in hoist.params}
+    w(hoist.c_code(len(params), pnames, _block))
     w('\n#include "hybrid.c"\n')
 
     meta = {
@@ -306,7 +281,15 @@ def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     return switching_surfaces(exprs, [*m.q, *m.qd, t])
 
 
-def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict, params: list[str]) -> str:
+def _defs_code(defs: Any, nm: dict[sp.Symbol, str], hoist: Hoister) -> str:
+    """Statements of a rigid-body tree's named intermediate quantities (``k_i``), hoisted."""
+    rhs = hoist([e for _, e in defs])
+    pr = _Printer({**nm, **hoist.names})
+    return "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for (s, _), e in zip(defs, rhs))
+
+
+def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict, params: list[str],
+                hoist: Hoister) -> str:
     head = f"static int reset_{i}(double t, const double *x, const double *p, double *xout, int *target) {{\n"
     head += "    (void)t; (void)x; (void)p; (void)xout;\n"
     if tr.reset is None:
@@ -321,7 +304,7 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
         qn = target_exprs(dst.model, reset.q, what, source=m)
         vn = target_exprs(dst.model, reset.qd, what, velocities=True, source=m)
         body += f"    double y[{2 * nd}];\n"
-        body += _block([f"y[{j}]" for j in range(2 * nd)], qn + vn, nm)
+        body += _block([f"y[{j}]" for j in range(2 * nd)], hoist(qn + vn), {**nm, **hoist.names})
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
         return head + body + "}\n"
     prelude = ""
@@ -329,8 +312,7 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
         defs, Mc, _ = eq.compact
         eq = replace(eq, M=Mc)
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
-        pr = _Printer(nm)
-        prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
+        prelude = _defs_code(defs, nm, hoist)
     imp = impulse_data(m, eq, reset, dst.model, what)  # Impact or Lock (validated when declared)
     Me, Jc, qn, dq = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
     ne, nc = Me.shape[0], Jc.shape[0]
@@ -343,7 +325,7 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
     ex += qn
     tg += [f"T[{a * n + b}]" for a in range(nd) for b in range(n)]
     ex += [dq[a, b] for a in range(nd) for b in range(n)]
-    body += _block(tg, ex, nm, prelude=prelude)
+    body += _block(tg, hoist(ex), {**nm, **hoist.names}, prelude=prelude)
     body += f"    for (int j = 0; j < {ne}; ++j) v[j] = j < {n} ? x[{n} + j] : 0.0;\n"
     body += f"    int err = amble_impulse({ne}, {nc}, Me, Jc, v);\n    if (err) return err;\n"
     body += f"    for (int a = 0; a < {nd}; ++a) {{\n        double s = 0.0;\n"

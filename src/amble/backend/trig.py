@@ -68,10 +68,13 @@ def pythagoras(exprs: list[sp.Expr]) -> list[sp.Expr]:
         if not kids:
             return e
         rebuilt = e if all(a is b for a, b in zip(kids, e.args)) else e.func(*kids)
-        if isinstance(rebuilt, sp.Add):
+        # repeated: a pair's common factor may pair with another term (r·sin²a·sin²b +
+        # r·sin²b·cos²a + r·cos²b → r·sin²b + r·cos²b → r, a direction with two angles)
+        while isinstance(rebuilt, sp.Add):
             paired = _pair_up(list(rebuilt.args))
-            if paired is not None:
-                return sp.Add(*paired)
+            if paired is None:
+                break
+            rebuilt = sp.Add(*paired)
         return rebuilt
 
     return [fold(sp.sympify(x), children, combine, memo) for x in exprs]

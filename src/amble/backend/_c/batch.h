@@ -112,6 +112,7 @@ static double section_residual(int mode, int tr, int row, double t, const double
 void amble_project_batch(int64_t n, int64_t *next, int mode, int tr, int row, double t, const double *pre,
                          const int64_t *S, int ns, const double *x, const double *p, double tol, int max_iter,
                          double *y_out, int *ok) {
+    AMBLE_PARAMS(p); /* the kernels below read the hoisted values too (amble_walk_batch gets them from amble_simulate) */
     const int nv = MODE_NX[mode], m = 1 + ns;
     int64_t own = 0;
     for (;;) {

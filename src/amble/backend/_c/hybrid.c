@@ -20,6 +20,9 @@
  *   void dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G);
  *   void energy(int mode, double t, const double *x, const double *p, double *out);
  *   void kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel);
+ *   AMBLE_PARAMS(p): replaces the caller's NPARAM parameters p by the array of NPARAM + NHOIST
+ *     values that every kernel reads (parameters, then their parameter-only subexpressions);
+ *     each exported entry point that calls kernels starts with it (here and in batch.h)
  */
 #include <stdint.h>
 
@@ -41,6 +44,7 @@
 int amble_simulate(const double *p, double *ctx, const double *opt, const int64_t *iopt,
                    double *out_t, int *out_mode, double *out_x, int64_t *n_out,
                    double *ev_t, int *ev_tr, double *ev_xpre, double *ev_xpost, int64_t *n_ev, double *sens) {
+    AMBLE_PARAMS(p); /* the parameters and their hoisted subexpressions (backend/hoist.py) */
     Rec rec = {out_t, out_x, ev_t, ev_xpre, ev_xpost, out_mode, ev_tr, n_out, n_ev, iopt[IO_OUTCAP], iopt[IO_EVCAP]};
     const int recording = rec.out_cap > 0, ev_recording = rec.ev_cap > 0;
     const double t_end = opt[OP_TEND], rtol = opt[OP_RTOL], atol = opt[OP_ATOL];
@@ -255,43 +259,53 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
 
 /* ---- thin exported wrappers for analysis from Python (rows = many states at once) ---- */
 int amble_rhs(int mode, double t, const double *x, const double *p, double *dx) {
+    AMBLE_PARAMS(p);
     return rhs(mode, t, x, p, dx);
 }
 
 void amble_guards(int mode, double t, const double *x, const double *p, double *g) {
+    AMBLE_PARAMS(p);
     guards(mode, t, x, p, g);
 }
 
 int amble_reset(int tr, double t, const double *x, const double *p, double *xout, int *target) {
+    AMBLE_PARAMS(p);
     return reset(tr, t, x, p, xout, target);
 }
 
 int amble_rhs_jac(int mode, double t, const double *x, const double *p, double *dx, double *J) {
+    AMBLE_PARAMS(p);
     return rhs_jac(mode, t, x, p, dx, J);
 }
 
 int amble_rhs_jacp(int mode, double t, const double *x, const double *p, double *J) {
+    AMBLE_PARAMS(p);
     return rhs_jacp(mode, t, x, p, J);
 }
 
 void amble_surfaces_grad(int mode, double t, const double *x, const double *p, double *G) {
+    AMBLE_PARAMS(p);
     surfaces_grad(mode, t, x, p, G);
 }
 
 int amble_reset_jac(int tr, double t, const double *x, const double *p, double *D) {
+    AMBLE_PARAMS(p);
     return reset_jac(tr, t, x, p, D);
 }
 
 void amble_dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G) {
+    AMBLE_PARAMS(p);
     dynamics(mode, t, x, p, M, h, G);
 }
 
 void amble_rows_energy(int64_t nrows, const double *t, const int *mode, const double *x, const double *p, double *out) {
+    AMBLE_PARAMS(p);
     for (int64_t r = 0; r < nrows; ++r) energy(mode[r], t[r], x + r * NXMAX, p, out + 2 * r);
 }
 
 void amble_rows_kinematics(int64_t nrows, const double *t, const int *mode, const double *x, const double *p,
                            double *pos, double *vel) {
+    AMBLE_PARAMS(p);
     for (int64_t r = 0; r < nrows; ++r)
         kinematics(mode[r], t[r], x + r * NXMAX, p, pos + r * NPOINTS * 3, vel + r * NPOINTS * 3);
 }
