@@ -169,7 +169,9 @@ class RigidTree:
         rotation ``Rz(yaw) Ry(pitch) Rx(roll)`` of the joint frame) and a ``floating`` one (6:
         ``<coordinate>_x``, ``_y``, ``_z`` along the joint frame's axes, then yaw, pitch, roll)
         are chains of one-axis joints through massless frames — Euler angles, singular at
-        pitch = ±π/2 (gimbal lock), which a walker's base does not reach.
+        pitch = ±π/2 (gimbal lock), which a walker's base does not reach. Their ``post_xyz`` /
+        ``post_rotation`` place the body after the last rotation: a point foot pivoting at its
+        sole, ``Joint("spherical", post_xyz=(0, 0, 0.06))`` for a foot frame 6 cm above the sole.
         """
         joint = joint or Joint()
         m = self.model
@@ -179,8 +181,6 @@ class RigidTree:
             raise ModelError(f"model {m.name!r}: joint of body {name!r} has unknown type {joint.type!r} "
                              f"(known: {', '.join(JOINT_TYPES)})")
         if joint.type in _COMPOSITE:
-            if joint.post_xyz is not None or joint.post_rotation is not None:
-                raise ModelError(f"model {m.name!r}: a {joint.type} joint (body {name!r}) cannot be reversed")
             cname = coordinate or name
             *inner, last = _COMPOSITE[joint.type]
             for k, (suffix, kind, axis) in enumerate(inner):
@@ -189,7 +189,8 @@ class RigidTree:
                           ((0, 0, 0),) * 3, f"{cname}_{suffix}", None, internal=True)
                 parent = f"{name}.{suffix}"
             suffix, kind, axis = last
-            joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper)
+            joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper,
+                          post_xyz=joint.post_xyz, post_rotation=joint.post_rotation)
             coordinate = f"{cname}_{suffix}"
         return self._add(name, parent, joint, mass, com, inertia, coordinate, unit)
 
