@@ -23,6 +23,8 @@ from .modelling.geometry import R3, R, Rx, Ry, Rz, t, vector
 from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock
 from .modelling.model import Model
 from .modelling.sampled import sample_and_hold
+from .modelling.stance_feet import base_relabel, stance_feet_walker
+from .modelling.tree import Joint
 from .modelling.walker import Walker, distance_along_slope, heel_strike, height_above_slope, joint_lock, walker
 from .simulation.engine import Options
 from .simulation.simulate import simulate
@@ -33,9 +35,10 @@ from .viz import animate, plot_limit_cycle, plot_trajectory
 __all__ = [
     "NONNEGATIVE", "POSITIVE", "R", "R3", "Rx", "Ry", "Rz", "AmbleError", "CompileError", "ConvergenceError",
     "Domain", "Equations",
-    "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Model", "ModelError", "Options", "OutputError",
+    "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Joint", "Lock", "Model", "ModelError", "Options", "OutputError",
     "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
     "contact_force", "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
-    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate", "t",
+    "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate",
+    "base_relabel", "stance_feet_walker", "t",
     "unilateral_contact", "vector", "walker",
 ]

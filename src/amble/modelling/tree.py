@@ -150,6 +150,8 @@ class RigidTree:
         self.com_points: dict[str, Body] = {}
         #: velocity of each point defined on a body, by point name (no differentiation needed)
         self.point_velocities: dict[str, sp.Matrix] = {}
+        #: the body of each named point and its offset from the body origin (world axes, named)
+        self.point_frames: dict[str, tuple[Body, sp.Matrix]] = {}
         self.limits: dict[str, tuple[float | None, float | None]] = {}
         #: intermediate quantities of the recursions (body kinematics here, dynamics in derivation)
         self.defs = Defs()
@@ -227,6 +229,7 @@ class RigidTree:
         r = self.defs.vec(_matmul(b.R, b.com))
         m.point(name, self.defs.expand(b.p + r))
         self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
+        self.point_frames[name] = (b, r)
         self.com_points[name] = b
         if mass_e != 0:
             m.mass(name, mass_e)
@@ -244,6 +247,7 @@ class RigidTree:
         r = self.defs.vec(_matmul(b.R, _vec(at)))
         pos = self.model.point(name, self.defs.expand(b.p + r))
         self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
+        self.point_frames[name] = (b, r)
         return pos
 
     def __getitem__(self, name: str) -> Body:
