@@ -70,7 +70,7 @@ def test_tree_impact_blocks_equal_the_sum_over_bodies(robot, urdf):
     ST, mt, Jc = (m.tree.defs.expand(x) for x in tree_impact_terms(m.tree, point))
     masses = {k: v for k, v in m.masses.items() if k in m.tree.com_points}
     rng = np.random.default_rng(3)
-    for _ in range(5):
+    for _ in range(2):
         at = {q: sp.Float(v) for q, v in zip(m.q, rng.uniform(-1.2, 1.2, len(m.q)))}
         body_sum = sum(float(mi) * _num(m.jacobian(m.points[k]), at) for k, mi in masses.items())
         assert np.abs(_num(ST, at) - body_sum).max() <= 1e-12 * np.abs(body_sum).max()
@@ -116,7 +116,7 @@ def test_stance_feet_walker_conserves_angular_momentum_about_the_impact_point(ur
     assert abs(c[2]) <= 1e-9 and vel[0, pts.index("right_sole"), 2] < 0  # the swing foot lands
     # the relabelled pose is the same pose, seen from the new stance foot
     assert np.abs(pos[1] - (pos[0] - c)).max() <= 1e-12
-    assert np.abs(vel[1, pts.index("right_sole")]).max() == 0.0
+    assert np.abs(vel[1, pts.index("right_sole")]).max() <= 1e-15  # the new stance foot is at rest
     # angular momentum about the impact point: the ground's impulse acts there only
     masses = {name: float(v) for name, v in modes["left"].masses.items()}
     P = sum(mv * vel[0, pts.index(name)] for name, mv in masses.items())
@@ -125,11 +125,7 @@ def test_stance_feet_walker_conserves_angular_momentum_about_the_impact_point(ur
     assert np.abs(H_post - H_pre).max() <= 1e-12 * np.abs(H_pre).max()
     e = k.energy_rows(np.zeros(2), np.array([0, 1]), np.array([ev.x_pre, ev.x_post]), np.zeros(0))
     assert e[1, 0] < e[0, 0]  # a plastic impact loses kinetic energy
-    assert e[1, 1] - e[0, 1] == pytest.approx(-masses_total(masses) * 9.81 * c[2], abs=1e-9)
-
-
-def masses_total(masses):
-    return sum(masses.values())
+    assert e[1, 1] == pytest.approx(e[0, 1] - sum(masses.values()) * 9.81 * c[2], rel=1e-12)  # same pose
 
 
 def test_stance_feet_walker_needs_a_pivot_at_the_stance_foot(urdf):
