@@ -26,17 +26,18 @@ _LEG = """
   <link name="{s}_foot"><inertial><origin xyz="0.03 0 -0.02"/><mass value="0.8"/>
     <inertia ixx="0.0008" iyy="0.003" izz="0.0035" ixy="0.0001" ixz="-0.00007" iyz="0.00004"/></inertial></link>
   <joint name="{s}_hip_roll" type="revolute"><parent link="torso"/><child link="{s}_hip"/>
-    <origin xyz="0 {y} -0.08" rpy="{r} 0 0"/><axis xyz="1 0 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+    <origin xyz="0 {y} -0.08" rpy="{r} 0 0"/><axis xyz="1 0 0"/>{lim}</joint>
   <joint name="{s}_hip_pitch" type="revolute"><parent link="{s}_hip"/><child link="{s}_thigh"/>
-    <origin xyz="0 0 -0.05"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+    <origin xyz="0 0 -0.05"/><axis xyz="0 1 0"/>{lim}</joint>
   <joint name="{s}_knee" type="revolute"><parent link="{s}_thigh"/><child link="{s}_shin"/>
-    <origin xyz="0.004 0 -0.38" rpy="0 0.04 0"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+    <origin xyz="0.004 0 -0.38" rpy="0 0.04 0"/><axis xyz="0 1 0"/>{lim}</joint>
   <joint name="{s}_ankle" type="fixed"><parent link="{s}_shin"/><child link="{s}_foot"/>
     <origin xyz="0 0 -0.38"/></joint>"""
+_LIM = '<limit lower="-2" upper="2" effort="1" velocity="1"/>'
 BIPED = ('<?xml version="1.0"?>\n<robot name="biped6">\n  <link name="torso"><inertial><origin xyz="0.01 0 0.18"/>'
          '<mass value="12"/><inertia ixx="0.3" iyy="0.26" izz="0.12" ixy="0.01" ixz="-0.006" iyz="0.003"/>'
-         '</inertial></link>' + _LEG.format(s="left", y=0.09, y2=0.01, r=0.02)
-         + _LEG.format(s="right", y=-0.09, y2=-0.01, r=-0.02) + "\n</robot>\n")
+         '</inertial></link>' + _LEG.format(s="left", y=0.09, y2=0.01, r=0.02, lim=_LIM)
+         + _LEG.format(s="right", y=-0.09, y2=-0.01, r=-0.02, lim=_LIM) + "\n</robot>\n")
 SOLES = {"left_sole": ("left_foot", (0.0, 0.0, -0.04)), "right_sole": ("right_foot", (0.0, 0.0, -0.04))}
 
 

@@ -35,7 +35,8 @@ from .viz import animate, plot_limit_cycle, plot_trajectory
 __all__ = [
     "NONNEGATIVE", "POSITIVE", "R", "R3", "Rx", "Ry", "Rz", "AmbleError", "CompileError", "ConvergenceError",
     "Domain", "Equations",
-    "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Joint", "Lock", "Model", "ModelError", "Options", "OutputError",
+    "Event", "Explicit", "Guard", "HybridSystem", "Impact", "Joint", "Lock", "Model", "ModelError", "Options",
+    "OutputError",
     "ParameterError", "RoundFoot", "SchedulerError", "SimulationError", "StateError", "Trajectory", "Walker", "animate",
     "contact_force", "derive", "distance_along_slope", "heel_strike", "height_above_slope", "interval", "joint_lock",
     "plot_limit_cycle", "plot_trajectory", "rolling_centre", "round_foot", "sample_and_hold", "simulate",
