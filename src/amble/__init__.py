@@ -28,6 +28,8 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("Explicit", "Guard", "HybridSystem", "Impact", "Lock"), ".modelling.hybrid"),
     "Model": ".modelling.model",
     "sample_and_hold": ".modelling.sampled",
+    **dict.fromkeys(("base_relabel", "stance_feet_walker"), ".modelling.stance_feet"),
+    "Joint": ".modelling.tree",
     **dict.fromkeys(("Walker", "distance_along_slope", "heel_strike", "height_above_slope", "joint_lock", "walker"),
                     ".modelling.walker"),
     "Options": ".simulation.engine",
@@ -76,6 +78,8 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
     from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock  # noqa: F401
     from .modelling.model import Model  # noqa: F401
     from .modelling.sampled import sample_and_hold  # noqa: F401
+    from .modelling.stance_feet import base_relabel, stance_feet_walker  # noqa: F401
+    from .modelling.tree import Joint  # noqa: F401
     from .modelling.walker import (  # noqa: F401
         Walker,
         distance_along_slope,

@@ -16,6 +16,7 @@ from dataclasses import replace
 from typing import Any
 
 import sympy as sp
+from sympy.core.relational import Relational
 
 from ..derivation.equations import derive
 from ..derivation.impact import impulse_data
@@ -199,9 +200,9 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
     for i, tr in enumerate(order):
         src = modes[tr.source]
         nm = _names(src.model, params)
-        cond = "1" if tr.guard.enabled is None else _bool_block(hoist.one(tr.guard.enabled), {**nm, **hoist.names})
+        enabled = None if tr.guard.enabled is None else hoist.one(tr.guard.enabled)
         w(f"static int enabled_{i}(double t, const double *x, const double *p) {{\n")
-        w(f"    (void)t; (void)x; (void)p;\n    return ({cond}) ? 1 : 0;\n}}\n")
+        w(_enabled_code(enabled, {**nm, **hoist.names}))
         w(_reset_code(i, tr, src, modes, nm, params, hoist))
 
     # derivatives for sensitivity runs and the implicit integrator, or stubs (variational_codegen)
@@ -274,6 +275,32 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
     return "".join(out), meta
 
 
+def _enabled_code(enabled: Any, nm: dict) -> str:
+    """The body of an enabling condition: the two sides of each comparison computed with shared
+    subexpressions first (a rigid-body tree's positions are shared graphs, which printed as one
+    expression would be written out at every use), then the condition of those values."""
+    head = "    (void)t; (void)x; (void)p;\n"
+    if enabled is None:
+        return head + "    return 1;\n}\n"
+    sides: list[sp.Expr] = []
+
+    def split(c: Any) -> Any:
+        if isinstance(c, (sp.And, sp.Or, sp.Not, sp.Xor)):
+            return c.func(*[split(a) for a in c.args])
+        if isinstance(c, Relational):
+            sides.extend([c.lhs, c.rhs])
+            syms = [sp.Symbol(f"e_{len(sides) - 2}", real=True), sp.Symbol(f"e_{len(sides) - 1}", real=True)]
+            return c.func(*syms, evaluate=False)
+        return c
+
+    cond = split(sp.sympify(enabled))
+    if not sides:
+        return head + f"    return ({_bool_block(cond, nm)}) ? 1 : 0;\n}}\n"
+    names = {**nm, **{sp.Symbol(f"e_{j}", real=True): f"e[{j}]" for j in range(len(sides))}}
+    body = f"    double e[{len(sides)}];\n" + _block([f"e[{j}]" for j in range(len(sides))], sides, nm)
+    return head + body + f"    return ({_bool_block(cond, names)}) ? 1 : 0;\n}}\n"
+
+
 def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     """Switching surfaces of a mode's right-hand side (forces, controllers, the mass matrix)."""
     eq, m = mi.equations, mi.model
@@ -308,12 +335,14 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
         return head + body + "}\n"
     prelude = ""
-    if eq.compact is not None:  # a rigid-body tree: M with its named intermediate quantities
-        defs, Mc, _ = eq.compact
-        eq = replace(eq, M=Mc)
+    compact = eq.compact is not None  # a rigid-body tree: M with its named intermediate quantities
+    if compact:
+        eq = replace(eq, M=eq.compact[1])
+    imp = impulse_data(m, eq, reset, dst.model, what, compact=compact)  # Impact or Lock (validated when declared)
+    if compact:  # the impulse's named quantities: M's and those of the tree's impact blocks
+        defs = list(imp.defs) or eq.compact[0]
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
         prelude = _defs_code(defs, nm, hoist)
-    imp = impulse_data(m, eq, reset, dst.model, what)  # Impact or Lock (validated when declared)
     Me, Jc, qn, dq = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
     ne, nc = Me.shape[0], Jc.shape[0]
     body += f"    double Me[{ne * ne}], Jc[{nc * ne}], v[{ne}], qn[{nd}], T[{nd * n}];\n"

@@ -146,7 +146,9 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
         code = jacobian_block(exprs, [None] * len(exprs), lambda o, j: f"D[{o} * (SC + 1) + {cols[j]}]", inputs, names)
         return head + clear + code + "    return 0;\n}\n"
     defs, Mc, _ = _defs(src)
-    imp = impulse_data(m, replace(src.equations, M=Mc), tr.reset, dst.model, what)
+    imp = impulse_data(m, replace(src.equations, M=Mc), tr.reset, dst.model, what,
+                       compact=src.equations.compact is not None)
+    defs = list(imp.defs) or defs  # a tree's impact blocks name quantities of their own
     Me, Jc, qn, T = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
     ne, nc = Me.shape[0], Jc.shape[0]
     nk = ne + nc

@@ -15,6 +15,10 @@ module derives its symbolic ingredients:
   impact the base is at rest: ``q̇e⁻ = (q̇⁻, 0)``.
 * **Lock** ``c(q) = 0`` (e.g. a knee): no extension, ``M_e = M`` and ``J = ∂c/∂q``.
 
+For a rigid-body tree the blocks ``S``, ``mₜ`` and ``J`` come from the tree's recursion
+(:mod:`amble.derivation.tree_impact`), not from the sum over its bodies; only point masses placed
+outside the tree's bodies are summed.
+
 Then the coordinates are relabelled for the target mode, ``q_new = r(q)``, and velocities follow
 by the chain rule: ``q̇_new = (∂r/∂q) q̇⁺`` — :attr:`ImpulseData.velocity_map` is ``∂r/∂q``
 (only the first ``n`` entries of ``q̇e⁺`` are used; the base velocity is dropped).
@@ -22,6 +26,7 @@ by the chain rule: ``q̇_new = (∂r/∂q) q̇⁺`` — :attr:`ImpulseData.veloc
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import sympy as sp
@@ -29,7 +34,9 @@ import sympy as sp
 from ..errors import ModelError
 from ..modelling.hybrid import Impact, Lock, Reset, target_exprs
 from ..modelling.model import Model
+from ..modelling.tree import RigidTree
 from .equations import Equations
+from .tree_impact import tree_impact_terms
 
 
 @dataclass(frozen=True)
@@ -38,18 +45,23 @@ class ImpulseData:
 
     ``Me``: (extended) mass matrix, ``ne × ne``; ``Jc``: constraint Jacobian, ``nc × ne``;
     ``q_new``: target coordinates as expressions of the source coordinates; ``velocity_map``:
-    ``∂q_new/∂q``, ``nd × n``.
+    ``∂q_new/∂q``, ``nd × n``; ``defs``: the named intermediate quantities ``(symbol,
+    definition)`` that ``Me`` and ``Jc`` use, in order (a tree model's, when asked for in compact
+    form; empty otherwise).
     """
 
     Me: sp.Matrix
     Jc: sp.Matrix
     q_new: list[sp.Expr]
     velocity_map: sp.Matrix
+    defs: Sequence[tuple[sp.Symbol, sp.Expr]] = ()
 
 
-def extended_impact_data(model: Model, equations: Equations, point: str) -> tuple[sp.Matrix, sp.Matrix]:
+def extended_impact_data(model: Model, equations: Equations, point: str,
+                         compact: bool = False) -> tuple[sp.Matrix, sp.Matrix]:
     """Mass matrix ``M_e`` and contact Jacobian ``J`` of the model extended with its base position
-    (see the module docstring), for a plastic impact of ``point``."""
+    (see the module docstring), for a plastic impact of ``point``. ``compact``: a tree's blocks
+    stay in its named intermediate quantities (``equations.M`` should then be the compact ``M``)."""
     if model._k_override is not None or model._l_override is not None:
         raise ModelError(
             f"model {model.name!r}: an Impact reset needs the kinetic energy from point masses "
@@ -70,7 +82,16 @@ def extended_impact_data(model: Model, equations: Equations, point: str) -> tupl
     n, d = len(model.q), model.dims
     S = sp.zeros(n, d)
     mt = sp.Integer(0)
+    tree = model.tree if isinstance(model.tree, RigidTree) and point in model.tree.point_frames else None
+    Jp = None
+    if tree is not None:
+        ST, mt, Jp = tree_impact_terms(tree, point)
+        if not compact:
+            ST, mt, Jp = tree.defs.expand(ST), tree.defs.expand(mt), tree.defs.expand(Jp)
+        S = ST.T
     for name, m in model.masses.items():
+        if tree is not None and name in tree.com_points:
+            continue  # the tree's bodies (as in its M)
         J = model.jacobian(model.points[name])
         S += m * J.T
         mt += m
@@ -80,7 +101,7 @@ def extended_impact_data(model: Model, equations: Equations, point: str) -> tupl
     Me[n:, :n] = S.T
     Me[n:, n:] = mt * sp.eye(d)
     Jc = sp.zeros(d, n + d)
-    Jc[:, :n] = model.jacobian(model.points[point])
+    Jc[:, :n] = Jp if Jp is not None else model.jacobian(model.points[point])
     Jc[:, n:] = sp.eye(d)
     return Me, Jc
 
@@ -92,16 +113,21 @@ def lock_jacobian(model: Model, constraint: sp.Expr) -> sp.Matrix:
 
 
 def impulse_data(model: Model, equations: Equations, reset: Reset, target_model: Model,
-                 what: str = "reset") -> ImpulseData:
+                 what: str = "reset", compact: bool = False) -> ImpulseData:
     """The impulsive reset of an :class:`~amble.modelling.hybrid.Impact` or
     :class:`~amble.modelling.hybrid.Lock` from ``model`` (with its derived ``equations``) into
-    ``target_model``; ``what`` names the transition in error messages."""
+    ``target_model``; ``what`` names the transition in error messages. ``compact``: ``Me`` and
+    ``Jc`` of a tree model in its named intermediate quantities, listed in
+    :attr:`ImpulseData.defs` (``equations.M`` is then the compact ``M``, as code generation has it)."""
     if isinstance(reset, Impact):
-        Me, Jc = extended_impact_data(model, equations, reset.point)
+        Me, Jc = extended_impact_data(model, equations, reset.point, compact)
     elif isinstance(reset, Lock):
         Me, Jc = equations.M, lock_jacobian(model, reset.constraint)
     else:
         raise ModelError(f"{what}: {type(reset).__name__} is not an impulsive reset (Impact or Lock)")
     q_new = target_exprs(target_model, reset.relabel, what, source=model)
-    velocity_map = sp.Matrix(q_new).jacobian(model.q)
-    return ImpulseData(Me=Me, Jc=Jc, q_new=q_new, velocity_map=velocity_map)
+    # model.jacobian: a tree's relabelling (the new base's angles from a foot's rotation) is a
+    # shared graph, differentiated once per shared part
+    velocity_map = model.jacobian(sp.Matrix(q_new)) if q_new else sp.zeros(0, len(model.q))
+    defs = model.tree.defs.needed([*Me, *Jc]) if compact and model.tree is not None else []
+    return ImpulseData(Me=Me, Jc=Jc, q_new=q_new, velocity_map=velocity_map, defs=defs)

@@ -56,7 +56,7 @@ def dag_diff(expr: Any, x: sp.Symbol, memo: dict | None = None) -> sp.Expr:
     subexpressions with ``expr``; it is built unevaluated where that keeps sharing."""
     memo = {} if memo is None else memo
     zero = sp.Integer(0)
-    rules = (sp.Add, sp.Mul, sp.Pow, sp.sin, sp.cos)
+    rules = (sp.Add, sp.Mul, sp.Pow, sp.sin, sp.cos, sp.atan2)
 
     def children(e: sp.Basic) -> Sequence[sp.Basic]:
         return e.args if isinstance(e, rules) and not e.is_Atom else ()
@@ -81,6 +81,13 @@ def dag_diff(expr: Any, x: sp.Symbol, memo: dict | None = None) -> sp.Expr:
             if d[1] != 0:
                 return sp.diff(e, x)
             return sp.Mul(n, sp.Pow(b, n - 1), d[0], evaluate=False) if d[0] != 0 else zero
+        if isinstance(e, sp.atan2):  # atan2(y, x)' = (x y' − y x') / (x² + y²)
+            (y, xx), (dy, dx) = e.args, d
+            if dy == 0 and dx == 0:
+                return zero
+            num = sp.Add(sp.Mul(xx, dy, evaluate=False), sp.Mul(-1, y, dx, evaluate=False), evaluate=False)
+            den = sp.Add(sp.Pow(xx, 2, evaluate=False), sp.Pow(y, 2, evaluate=False), evaluate=False)
+            return sp.Mul(num, sp.Pow(den, -1, evaluate=False), evaluate=False)
         if isinstance(e, sp.sin):
             return sp.Mul(sp.cos(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero
         return sp.Mul(-1, sp.sin(e.args[0]), d[0], evaluate=False) if d[0] != 0 else zero

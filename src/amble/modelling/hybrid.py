@@ -35,6 +35,7 @@ import sympy as sp
 from sympy.core.relational import Relational
 
 from ..errors import ModelError, ParameterError
+from .dag import free_symbols
 from .expressions import checked_expr
 from .geometry import t as _TIME
 from .model import Model
@@ -255,13 +256,14 @@ class HybridSystem:
         names = {str(s_): s_ for s_ in [*m.q, *m.qd, *m.params, _TIME]}
         expr = checked_expr(self.name, _read(guard.expr, names, f"system {self.name!r}: {what}: "), what)
         allowed = set(m.q) | set(m.qd) | set(m.params) | {_TIME}
-        if not (expr.free_symbols & (set(m.q) | set(m.qd))):
+        # free symbols visited once per shared part: a tree's positions are DAGs (exponential otherwise)
+        if not (free_symbols(expr) & (set(m.q) | set(m.qd))):
             raise ModelError(
                 f"system {self.name!r}: a guard of mode {source!r} does not depend on the state: {expr}"
             )
         enabled = _condition(self.name, guard.enabled, names, f"{what}: enabling condition")
         for e in (expr, enabled if enabled is not None else sp.true):
-            bad = sorted(str(s) for s in e.free_symbols - allowed)
+            bad = sorted(str(s) for s in free_symbols(e) - allowed)
             if bad:
                 raise ModelError(
                     f"system {self.name!r}: guard of mode {source!r} uses unknown symbols {', '.join(bad)}"
@@ -372,6 +374,6 @@ def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
 
 def _check_free(exprs: list[sp.Expr], allowed: set, what: str, label: str) -> None:
     for e in exprs:
-        bad = sorted(str(s) for s in e.free_symbols - allowed)
+        bad = sorted(str(s) for s in free_symbols(e) - allowed)
         if bad:
             raise ModelError(f"{what}: uses {', '.join(bad)}, not among the {label} or parameters")

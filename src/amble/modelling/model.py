@@ -163,16 +163,17 @@ class Model(Actuators):
     @classmethod
     def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,
                   name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
-                  base_joint: Any = None, base_coordinate: str = "base", parameters: Any = False) -> Model:
+                  base_joint: Any = None, base_coordinate: str = "base", parameters: Any = False,
+                  pivot: str | None = None) -> Model:
         """The robot of a URDF file with the link ``base`` fixed to the world (or attached by
         ``base_joint``), ``contact_points``, and with ``parameters`` (``True`` or kinds among
-        ``mass``, ``com``, ``inertia``, ``length``) its numbers as named run-time parameters — see
-        :mod:`amble.modelling.urdf`."""
+        ``mass``, ``com``, ``inertia``, ``length``) its numbers as named run-time parameters, and
+        the base joint centred at the contact point ``pivot`` — see :mod:`amble.modelling.urdf`."""
         from .urdf import build_model
 
         return build_model(cls, path, base=base, contact_points=contact_points, name=name,
                            allow_massless=allow_massless, gravity=gravity, base_joint=base_joint,
-                           base_coordinate=base_coordinate, parameters=parameters)
+                           base_coordinate=base_coordinate, parameters=parameters, pivot=pivot)
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""

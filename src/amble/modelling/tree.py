@@ -150,6 +150,8 @@ class RigidTree:
         self.com_points: dict[str, Body] = {}
         #: velocity of each point defined on a body, by point name (no differentiation needed)
         self.point_velocities: dict[str, sp.Matrix] = {}
+        #: the body of each named point and its offset from the body origin (world axes, named)
+        self.point_frames: dict[str, tuple[Body, sp.Matrix]] = {}
         self.limits: dict[str, tuple[float | None, float | None]] = {}
         #: intermediate quantities of the recursions (body kinematics here, dynamics in derivation)
         self.defs = Defs()
@@ -169,7 +171,9 @@ class RigidTree:
         rotation ``Rz(yaw) Ry(pitch) Rx(roll)`` of the joint frame) and a ``floating`` one (6:
         ``<coordinate>_x``, ``_y``, ``_z`` along the joint frame's axes, then yaw, pitch, roll)
         are chains of one-axis joints through massless frames — Euler angles, singular at
-        pitch = ±π/2 (gimbal lock), which a walker's base does not reach.
+        pitch = ±π/2 (gimbal lock), which a walker's base does not reach. Their ``post_xyz`` /
+        ``post_rotation`` place the body after the last rotation: a point foot pivoting at its
+        sole, ``Joint("spherical", post_xyz=(0, 0, 0.06))`` for a foot frame 6 cm above the sole.
         """
         joint = joint or Joint()
         m = self.model
@@ -179,8 +183,6 @@ class RigidTree:
             raise ModelError(f"model {m.name!r}: joint of body {name!r} has unknown type {joint.type!r} "
                              f"(known: {', '.join(JOINT_TYPES)})")
         if joint.type in _COMPOSITE:
-            if joint.post_xyz is not None or joint.post_rotation is not None:
-                raise ModelError(f"model {m.name!r}: a {joint.type} joint (body {name!r}) cannot be reversed")
             cname = coordinate or name
             *inner, last = _COMPOSITE[joint.type]
             for k, (suffix, kind, axis) in enumerate(inner):
@@ -189,7 +191,8 @@ class RigidTree:
                           ((0, 0, 0),) * 3, f"{cname}_{suffix}", None, internal=True)
                 parent = f"{name}.{suffix}"
             suffix, kind, axis = last
-            joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper)
+            joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper,
+                          post_xyz=joint.post_xyz, post_rotation=joint.post_rotation)
             coordinate = f"{cname}_{suffix}"
         return self._add(name, parent, joint, mass, com, inertia, coordinate, unit)
 
@@ -226,6 +229,7 @@ class RigidTree:
         r = self.defs.vec(_matmul(b.R, b.com))
         m.point(name, self.defs.expand(b.p + r))
         self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
+        self.point_frames[name] = (b, r)
         self.com_points[name] = b
         if mass_e != 0:
             m.mass(name, mass_e)
@@ -243,6 +247,7 @@ class RigidTree:
         r = self.defs.vec(_matmul(b.R, _vec(at)))
         pos = self.model.point(name, self.defs.expand(b.p + r))
         self.point_velocities[name] = self.defs.expand(b.vel + b.omega.cross(r))
+        self.point_frames[name] = (b, r)
         return pos
 
     def __getitem__(self, name: str) -> Body:

@@ -32,6 +32,7 @@ and characters other than letters, digits and ``_`` in a name become ``_``.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Collection, Mapping
 from pathlib import Path
@@ -115,12 +116,21 @@ def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
                 name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
                 base_joint: Joint | None = None, base_coordinate: str = "base",
-                parameters: bool | Collection[str] = False) -> Any:
+                parameters: bool | Collection[str] = False, pivot: str | None = None) -> Any:
     """A model (of class ``cls``, a :class:`~amble.modelling.model.Model`) of the URDF at ``path``
     with ``base`` fixed to the world (default: the URDF's root link), or attached to it by
     ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``;
-    ``parameters``: which numbers become named model parameters (module docstring)."""
+    ``parameters``: which numbers become named model parameters (module docstring); ``pivot``:
+    a contact point on the base link where ``base_joint`` is centred (a point foot pivoting at
+    its sole) instead of the link's origin."""
     path = Path(path)
+    if pivot is not None:
+        spec = (contact_points or {}).get(pivot)
+        if base_joint is None or spec is None or spec[0] != (base or spec[0]):
+            raise ModelError(f"pivot {pivot!r}: give a base_joint and a contact point of that name on the base link")
+        if base_joint.post_xyz is not None:
+            raise ModelError(f"pivot {pivot!r}: the base joint has an offset after its motion already")
+        base_joint = dataclasses.replace(base_joint, post_xyz=tuple(-float(v) for v in spec[1]))
     robot = _read(path).robot
     links = {lk.name: lk for lk in robot.links}
     joints = list(robot.joints)

@@ -117,7 +117,9 @@ def heel_strike(model: Model, foot: str | RoundFoot, slope: Any, relabel: Mappin
     ahead = distance_along_slope(model, contact, slope)
     if stance is not None:
         ahead -= distance_along_slope(model, stance.contact if isinstance(stance, RoundFoot) else stance, slope)
-    guard = Guard(height_above_slope(model, contact, slope), -1, ahead > margin)
+    # unevaluated: deciding ``ahead > margin`` asks sympy for signs of the whole expression, which
+    # for a rigid-body tree's positions (shared graphs) takes minutes; the compiled code decides it
+    guard = Guard(height_above_slope(model, contact, slope), -1, sp.StrictGreaterThan(ahead, margin, evaluate=False))
     return guard, Impact(foot.rolling if isinstance(foot, RoundFoot) else foot, relabel)
 
 
