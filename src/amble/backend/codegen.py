@@ -32,7 +32,7 @@ from .variational_codegen import derivative_kernels, derivative_stubs
 
 
 def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, nm: dict[sp.Symbol, str],
-                   prelude: str) -> str:
+                   prelude: str, prelude_ops: int = 0) -> str:
     """``mh_k`` (the lower triangle of M, h and Γ — emitted once: for a large tree it is most of
     the unit and of the compile time), and the two kernels that use it: ``rhs_k`` (q̈ = M⁻¹ (Γ − h)
     by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display)."""
@@ -41,8 +41,9 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
     ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
     # small kernels are inlined into both callers (a call costs as much as their body); large ones
-    # are compiled once, which is the point of emitting them once
-    inline = "AMBLE_INLINE " if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
+    # are compiled once, which is the point of emitting them once (a tree's M and h are names: its
+    # size is in the prelude — inlined twice, the 30-DOF humanoid's unit took 22 s of gcc, not 11)
+    inline = "AMBLE_INLINE " if prelude_ops + sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
     sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
     out = [f"static {inline}void mh_{k}{sig} {{\n",
            "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n"]
@@ -164,7 +165,8 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
         pr = _Printer(nm)
         prelude = "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for s, e in defs)
-        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude))
+        # each named quantity is at least one operation: a lower bound of the prelude's size
+        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude, len(defs)))
         # guards of this mode's transitions
         trs = trs_by_mode[name]
         w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")
@@ -202,7 +204,7 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
             e_ex = [eq.energy, sp.Integer(0)]
         w(f"static void energy_{k}(double t, const double *x, const double *p, double *out) {{\n")
         w("    (void)t; (void)p;\n")
-        w(_block(["out[0]", "out[1]"], e_ex, nm))
+        w(_block(["out[0]", "out[1]"], e_ex, nm, shared=m.tree is not None))
         w("}\n")
         # kinematics of named points (3 components each; 2D models have y = 0)
         tg, ex = [], []
@@ -219,7 +221,7 @@ def generate(system: HybridSystem, derivatives: bool = False) -> tuple[str, dict
         w(f"static void kinematics_{k}(double t, const double *x, const double *p, double *pos, double *vel) {{\n")
         w("    (void)t; (void)x; (void)p;\n")
         w(f"    for (int i = 0; i < {3 * len(points)}; ++i) {{ pos[i] = NAN; vel[i] = NAN; }}\n")
-        w(_block(tg, ex, nm))
+        w(_block(tg, ex, nm, shared=m.tree is not None))
         w("}\n\n")
 
     # transitions: enabling conditions and resets
