@@ -28,6 +28,7 @@ from .codegen_support import block as _block
 from .codegen_support import bool_expr as _bool_block
 from .codegen_support import symbol_names as _names
 from .trig import pythagoras
+from .units import UNIT_BEGIN, UNIT_END
 from .variational_codegen import derivative_kernels, derivative_stubs
 
 
@@ -45,8 +46,10 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     # size is in the prelude — inlined twice, the 30-DOF humanoid's unit took 22 s of gcc, not 11)
     inline = "AMBLE_INLINE " if prelude_ops + sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
     sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
-    out = [f"static {inline}void mh_{k}{sig} {{\n",
-           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n"]
+    # a large one is a unit of its own, compiled beside the rest (units.split_units)
+    head, tail = (f"static {inline}", "") if inline else (UNIT_BEGIN + "AMBLE_HIDDEN ", UNIT_END)
+    out = [f"{head}void mh_{k}{sig} {{\n",
+           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n" + tail]
     out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
             f"    double M[{n * n}], h[{n}], f[{n}];\n",
             f"    mh_{k}(t, x, p, M, h, f);\n",
