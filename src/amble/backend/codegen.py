@@ -42,23 +42,30 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
     ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
     # small kernels are inlined into both callers (a call costs as much as their body); large ones
-    # are compiled once, which is the point of emitting them once (a tree's M and h are names: its
-    # size is in the prelude — inlined twice, the 30-DOF humanoid's unit took 22 s of gcc, not 11)
-    inline = "AMBLE_INLINE " if prelude_ops + sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
+    # are compiled once, in a unit of their own compiled beside the rest (units.split_units). A
+    # tree's M and h are names (its size is in the prelude): inlined into rhs_k, its q̈ is faster
+    # (the humanoid's 10.8 µs against 14.3 µs out of line), so rhs_k keeps an inlined copy and
+    # dynamics_k calls one in its own unit (both copies in one unit: 22 s of gcc instead of 11)
+    ops = sum(sp.count_ops(e) for e in ex)
     sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
-    # a large one is a unit of its own, compiled beside the rest (units.split_units)
-    head, tail = (f"static {inline}", "") if inline else (UNIT_BEGIN + "AMBLE_HIDDEN ", UNIT_END)
-    out = [f"{head}void mh_{k}{sig} {{\n",
-           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, nm, prelude=prelude), "}\n" + tail]
+    body = "    (void)t; (void)x; (void)p;\n" + _block(tg, ex, nm, prelude=prelude) + "}\n"
+    inlined, own = f"static AMBLE_INLINE void mh_{k}{sig} {{\n" + body, f"AMBLE_HIDDEN void mh_{k}_out{sig} {{\n" + body
+    if prelude_ops + ops <= INLINE_OPS:
+        out, dyn = [inlined], f"mh_{k}"
+    elif ops <= INLINE_OPS:
+        out, dyn = [inlined, UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
+    else:
+        out, dyn = [UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
+    rhs_mh = f"mh_{k}" if out[0] is inlined else dyn
     out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
             f"    double M[{n * n}], h[{n}], f[{n}];\n",
-            f"    mh_{k}(t, x, p, M, h, f);\n",
+            f"    {rhs_mh}(t, x, p, M, h, f);\n",
             f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
             ldl_solve_code(n, "M", "f"),
             f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
             "    return 0;\n}\n"]
     out += [f"static void dynamics_{k}{sig} {{\n",
-            f"    mh_{k}(t, x, p, M, h, G);\n",
+            f"    {dyn}(t, x, p, M, h, G);\n",
             f"    for (int i = 0; i < {n}; ++i)\n",
             f"        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
             "}\n"]
