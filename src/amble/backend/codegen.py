@@ -32,11 +32,12 @@ from .codegen_support import symbol_names as _names
 from .hoist import Hoister
 from .ldl import UNROLL_MAX, constant_pivots, ldl_order, ldl_solve_code
 from .trig import pythagoras
+from .units import UNIT_BEGIN, UNIT_END
 from .variational_codegen import derivative_kernels, derivative_stubs
 
 
 def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, nm: dict[sp.Symbol, str],
-                   prelude: str, hoist: Hoister) -> str:
+                   prelude: str, hoist: Hoister, prelude_ops: int = 0) -> str:
     """``mh_k`` (the lower triangle of M, h and Γ — emitted once: for a large tree it is most of
     the unit and of the compile time), and the two kernels that use it: ``rhs_k`` (q̈ = M⁻¹ (Γ − h)
     by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display). Parameter-only
@@ -54,20 +55,30 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     known = constant_pivots(sp.Matrix(n, n, lambda i, j: low(order[i], order[j])), nm, hoist)
     ex = hoist(ex)
     # small kernels are inlined into both callers (a call costs as much as their body); large ones
-    # are compiled once, which is the point of emitting them once
-    inline = "AMBLE_INLINE " if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS else ""
+    # are compiled once, in a unit of their own compiled beside the rest (units.split_units). A
+    # tree's M and h are names (its size is in the prelude): inlined into rhs_k, its q̈ is faster
+    # (the humanoid's 10.8 µs against 14.3 µs out of line), so rhs_k keeps an inlined copy and
+    # dynamics_k calls one in its own unit (both copies in one unit: 22 s of gcc instead of 11)
+    ops = sum(sp.count_ops(e) for e in ex)
     sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
-    out = [f"static {inline}void mh_{k}{sig} {{\n",
-           "    (void)t; (void)x; (void)p;\n", _block(tg, ex, {**nm, **hoist.names}, prelude=prelude), "}\n"]
+    body = "    (void)t; (void)x; (void)p;\n" + _block(tg, ex, {**nm, **hoist.names}, prelude=prelude) + "}\n"
+    inlined, own = f"static AMBLE_INLINE void mh_{k}{sig} {{\n" + body, f"AMBLE_HIDDEN void mh_{k}_out{sig} {{\n" + body
+    if prelude_ops + ops <= INLINE_OPS:
+        out, dyn = [inlined], f"mh_{k}"
+    elif ops <= INLINE_OPS:
+        out, dyn = [inlined, UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
+    else:
+        out, dyn = [UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
+    rhs_mh = f"mh_{k}" if out[0] is inlined else dyn
     out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
             f"    double M[{n * n}], h[{n}], f[{n}];\n",
-            f"    mh_{k}(t, x, p, M, h, f);\n",
+            f"    {rhs_mh}(t, x, p, M, h, f);\n",
             f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
             ldl_solve_code(n, "M", "f", known=known, order=order, nonzero=nonzero),
             f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
             "    return 0;\n}\n"]
     out += [f"static void dynamics_{k}{sig} {{\n",
-            f"    mh_{k}(t, x, p, M, h, G);\n",
+            f"    {dyn}(t, x, p, M, h, G);\n",
             f"    for (int i = 0; i < {n}; ++i)\n",
             f"        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
             "}\n"]
@@ -103,9 +114,9 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
 
     hoist = Hoister({s for mi in modes.values() for s in mi.model.params}, enabled=hoist_params)
 
-    def blk(targets: list[str], exprs: list, nm: dict, prelude: str = "") -> str:
+    def blk(targets: list[str], exprs: list, nm: dict, prelude: str = "", shared: bool = False) -> str:
         ex = hoist(exprs)
-        return _block(targets, ex, {**nm, **hoist.names}, prelude=prelude)
+        return _block(targets, ex, {**nm, **hoist.names}, prelude=prelude, shared=shared)
 
     out: list[str] = []
     w = out.append
@@ -138,7 +149,8 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         defs, eqM, eqh = eq.compact if eq.compact is not None else ((), eq.M, eq.h)
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
         prelude = _defs_code(defs, nm, hoist)
-        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude, hoist))
+        # each named quantity is at least one operation: a lower bound of the prelude's size
+        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude, hoist, len(defs)))
         # guards of this mode's transitions
         trs = trs_by_mode[name]
         w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")
@@ -176,7 +188,7 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
             e_ex = [eq.energy, sp.Integer(0)]
         w(f"static void energy_{k}(double t, const double *x, const double *p, double *out) {{\n")
         w("    (void)t; (void)p;\n")
-        w(blk(["out[0]", "out[1]"], e_ex, nm))
+        w(blk(["out[0]", "out[1]"], e_ex, nm, shared=m.tree is not None))
         w("}\n")
         # kinematics of named points (3 components each; 2D models have y = 0)
         tg, ex = [], []
@@ -193,7 +205,7 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         w(f"static void kinematics_{k}(double t, const double *x, const double *p, double *pos, double *vel) {{\n")
         w("    (void)t; (void)x; (void)p;\n")
         w(f"    for (int i = 0; i < {3 * len(points)}; ++i) {{ pos[i] = NAN; vel[i] = NAN; }}\n")
-        w(blk(tg, ex, nm))
+        w(blk(tg, ex, nm, shared=m.tree is not None))
         w("}\n\n")
 
     # transitions: enabling conditions and resets

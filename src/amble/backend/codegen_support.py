@@ -7,21 +7,36 @@ targets after one common-subexpression pass.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..derivation.equations import Equations
+from ..modelling.dag import fold
 from ..modelling.model import Model, t
 
 
 class Printer(C99CodePrinter):
-    """C99 printer mapping symbols to array reads and avoiding pow() for small integer powers."""
+    """C99 printer mapping symbols to array reads and avoiding pow() for small integer powers.
+
+    Terms and factors are printed in the order the expression holds them (``order="none"``):
+    sympy's default sorts every sum's terms first, which is most of the printing time of a large
+    model (2.6× on the 30-DOF humanoid's intermediate quantities) and changes nothing but the order
+    of the additions."""
 
     def __init__(self, names: dict[sp.Symbol, str]) -> None:
-        super().__init__()
+        super().__init__(settings={"order": "none"})
         self._names = names
+
+    def doprint(self, expr: Any, assign_to: Any = None) -> str:
+        """C text of ``expr``: sums, products, integer and half powers, sin and cos of numbers and
+        symbols directly (:func:`_c_text`), anything else by sympy's C99 printer."""
+        if assign_to is not None or not isinstance(expr, sp.Basic):
+            return super().doprint(expr, assign_to)
+        return _standalone(_c_text(self, expr))
 
     def _print_Symbol(self, expr: sp.Symbol) -> str:
         name = self._names.get(expr)
@@ -37,6 +52,88 @@ class Printer(C99CodePrinter):
         if e == -1:
             return f"(1.0/{self.parenthesize(base, 100)})"
         return super()._print_Pow(expr)
+
+
+# precedence of a printed piece: a sum, a product or quotient, an atom (a name, a call, brackets)
+_ADD, _MUL, _ATOM = 1, 2, 3
+_CALLS = {sp.sin: "sin", sp.cos: "cos"}
+
+
+def _standalone(piece: tuple[str, int, bool]) -> str:
+    text, _, neg = piece
+    return "-" + text if neg else text
+
+
+def _operand(piece: tuple[str, int, bool], need: int) -> str:
+    """A printed piece as an operand of an operator of precedence ``need`` (bracketed if it binds
+    less tightly, or is negated)."""
+    text, prec, neg = piece
+    if neg:
+        return f"(-{text})" if need > _ADD or prec <= _ADD else "-" + text
+    return f"({text})" if prec < need else text
+
+
+def _c_text(pr: Printer, e: sp.Basic) -> tuple[str, int, bool]:
+    """``(text, precedence, negated)`` of ``e`` in C: the value is ``-text`` if ``negated``.
+
+    Why not sympy's printer: its products ask sympy for the sign of every factor and build new
+    negated expressions to print them, which makes printing the largest part of generating a big
+    model's code. This prints the expression as it stands — each operation in the order and
+    grouping of the graph (a nested sum keeps its brackets) — and hands what it does not know
+    (other functions, piecewise, relations, constants such as π) to sympy's printer whole."""
+    if e.is_Symbol:
+        return pr._print_Symbol(e), _ATOM, False
+    if e.is_Integer:
+        v = int(e)
+        if abs(v) < 2 ** 31:
+            return str(abs(v)), _ATOM, v < 0
+    elif e.is_Rational:
+        p, q = int(e.p), int(e.q)
+        if abs(p) < 2 ** 53 and q < 2 ** 53:
+            return f"{abs(p)}.0/{q}.0", _MUL, p < 0
+    elif e.is_Float:
+        v = float(e)
+        if math.isfinite(v):
+            return repr(abs(v)), _ATOM, v < 0 or (v == 0 and math.copysign(1.0, v) < 0)
+    elif isinstance(e, sp.Add):
+        parts = []
+        for k, a in enumerate(e.args):
+            text, prec, neg = _c_text(pr, a)
+            text = f"({text})" if prec <= _ADD and (neg or k > 0) else text  # the graph's grouping
+            parts.append((" - " if neg else " + ") + text if k else ("-" + text if neg else text))
+        return "".join(parts), _ADD, False
+    elif isinstance(e, sp.Mul):
+        num, den, neg = [], [], False
+        for a in e.args:
+            if a.is_Pow and a.exp.is_Integer and -4 <= int(a.exp) <= -1:
+                b = _operand(_c_text(pr, a.base), _ATOM)
+                den.append("*".join([b] * -int(a.exp)))
+                continue
+            text, prec, n = _c_text(pr, a)
+            if a.is_Number and text == "1" and not num:
+                neg ^= n  # a coefficient ±1 is a sign
+                continue
+            neg ^= n
+            num.append(f"({text})" if prec < _MUL or (prec == _MUL and a.is_Rational) else text)
+        out = "*".join(num) if num else "1.0"
+        if den:
+            d = den[0] if len(den) == 1 and "*" not in den[0] else "(" + "*".join(den) + ")"
+            out = f"{out}/{d}" if num else f"1.0/{d}"
+        return out, _MUL, neg
+    elif e.is_Pow:
+        b, x = e.args
+        if x.is_Integer and 1 <= int(x) <= 4:
+            base = _operand(_c_text(pr, b), _ATOM)
+            return ("(" + "*".join([base] * int(x)) + ")") if int(x) > 1 else base, _ATOM, False
+        if x.is_Integer and -4 <= int(x) <= -1:
+            base = _operand(_c_text(pr, b), _ATOM)
+            d = base if int(x) == -1 else "(" + "*".join([base] * -int(x)) + ")"
+            return f"1.0/{d}", _MUL, False
+        if x == sp.S.Half:
+            return f"sqrt({_standalone(_c_text(pr, b))})", _ATOM, False
+    elif type(e) in _CALLS:
+        return f"{_CALLS[type(e)]}({_standalone(_c_text(pr, e.args[0]))})", _ATOM, False
+    return f"({C99CodePrinter.doprint(pr, e)})", _ATOM, False
 
 
 @dataclass
@@ -62,17 +159,65 @@ def symbol_names(model: Model, params: list[str]) -> dict[sp.Symbol, str]:
 
 
 def block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str], indent: str = "    ",
-          prelude: str = "") -> str:
+          prelude: str = "", shared: bool = False) -> str:
     """C statements assigning ``exprs`` to ``targets`` with shared subexpressions (after
-    ``prelude``, the statements of named intermediate quantities the expressions may use)."""
+    ``prelude``, the statements of named intermediate quantities the expressions may use).
+
+    ``shared``: the expressions are graphs whose common parts are already shared (a rigid-body
+    tree's kinematics and energies, expanded from its named intermediate quantities): each
+    subexpression used more than once becomes a temporary as it stands (:func:`shared_cse`),
+    instead of ``sympy.cse`` searching again for what the recursion built once."""
     if not exprs:
         return ""
-    repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
+    if shared:
+        repl, reduced = shared_cse(exprs)
+    else:
+        repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
     pr = Printer(names)
     lines = [prelude] if prelude else []
     lines += [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
     lines += [f"{indent}{tgt} = {pr.doprint(e)};" for tgt, e in zip(targets, reduced)]
     return "\n".join(lines) + "\n"
+
+
+def shared_cse(exprs: list[sp.Expr]) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """Common subexpressions of expression graphs, as ``sympy.cse`` returns them (temporaries in
+    an order where each comes after those it uses, then the reduced expressions): every
+    non-atomic subexpression reached from more than one place is named once. Linear in the
+    number of distinct subexpressions — no search for common parts of sums or products beyond
+    those the graph already shares, which is what a recursion over a tree leaves none of."""
+    exprs = [sp.sympify(e) for e in exprs]
+    uses: dict[sp.Basic, int] = {}
+    stack = list(exprs)
+    while stack:  # how often each distinct subexpression is an argument (or a root)
+        e = stack.pop()
+        if e.is_Atom:
+            continue
+        n = uses.get(e, 0)
+        uses[e] = n + 1
+        if n == 0:
+            stack.extend(e.args)
+    names = sp.numbered_symbols("c_", cls=sp.Dummy)
+    repl: list[tuple[sp.Symbol, sp.Expr]] = []
+
+    def combine(e: sp.Basic, args: list) -> sp.Basic:
+        if e.is_Atom:
+            return e
+        if all(a is b for a, b in zip(args, e.args)):
+            r = e
+        elif isinstance(e, (sp.Add, sp.Mul)):
+            r = e.func(*args, evaluate=False)  # as built: no re-flattening of shared parts
+        else:
+            r = e.func(*args)
+        if uses.get(e, 0) > 1:
+            s = next(names)
+            repl.append((s, r))
+            return s
+        return r
+
+    memo: dict = {}
+    reduced = [fold(e, lambda x: () if x.is_Atom else x.args, combine, memo) for e in exprs]
+    return repl, reduced
 
 
 def bool_expr(expr: sp.Basic, names: dict[sp.Symbol, str]) -> str:

@@ -17,6 +17,14 @@
 #define AMBLE_INLINE inline
 #endif
 
+/* A kernel compiled in a translation unit of its own (backend/cache.py: the two units of a large
+ * model compile in parallel) and linked into the same library: called directly, not exported. */
+#if defined(__GNUC__) || defined(__clang__)
+#define AMBLE_HIDDEN __attribute__((visibility("hidden")))
+#else
+#define AMBLE_HIDDEN
+#endif
+
 /* Error codes returned by kernels (0 = ok). */
 #define AMBLE_ERR_SINGULAR_MASS 1
 #define AMBLE_ERR_SINGULAR_RESET 2
