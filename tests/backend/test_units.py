@@ -35,3 +35,15 @@ def test_error_in_own_unit_is_a_compile_error(tmp_path):
     bad = SRC.replace("return 0.5 * x;", "return 0.5 * y;")
     with pytest.raises(CompileError, match="failed"):
         _compile(bad, "unitsbad", tmp_path)
+
+
+def test_own_unit_sees_the_defines_before_it(tmp_path):
+    # a tree's split-off mass-matrix kernel reads hoisted parameters as p[NPARAM + j]
+    src = ('#include "amble_core.h"\n#define NPARAM 2\n'
+           + UNIT_BEGIN + "AMBLE_HIDDEN double last(const double *p) {\n    return p[NPARAM + 0];\n}\n" + UNIT_END
+           + "double g(const double *p) { return last(p); }\n")
+    _, own = split_units(src)
+    assert "#define NPARAM 2" in own
+    lib = ctypes.CDLL(str(_compile(src, "unitsdefines", tmp_path)[0]))
+    lib.g.restype, lib.g.argtypes = ctypes.c_double, [ctypes.POINTER(ctypes.c_double)]
+    assert lib.g((ctypes.c_double * 3)(1.0, 2.0, 7.0)) == 7.0

@@ -26,7 +26,11 @@ def split_units(src: str) -> tuple[str, str | None]:
         rest = rest[j + len(UNIT_END):]
     if not own:
         return src, None
-    return "".join(main) + rest, '#include "amble_core.h"\n' + "".join(own)
+    # the split-off functions read the same constants (NPARAM, the hoisted p[NPARAM + j], ...):
+    # the unit starts with every top-level #include and #define that precedes them
+    head = src[:src.find(UNIT_BEGIN)].splitlines(keepends=True)
+    defines = "".join(ln for ln in head if ln.startswith(("#include", "#define")))
+    return "".join(main) + rest, defines + "".join(own)
 
 
 def run_compilers(cmds: list[list[str]], cc: str) -> None:
