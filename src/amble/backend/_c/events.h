@@ -256,6 +256,47 @@ static int approaching_slide(int mode, double t, const double *x, const double *
     return -1;
 }
 
+/* A switching surface the arithmetic cannot reach. Approached (g ġ < 0) to within the rounding
+ * of the state, |g| ≤ 4 ε Σᵢ |∂g/∂xᵢ| |xᵢ|, it is no longer crossed by a step: a step long
+ * enough to move the state by one unit of rounding rounds some of its stages onto the far side,
+ * the jump of the right-hand side there fails the error test, and the steps accepted are those
+ * too short to move the state at all, so g keeps its value exactly (g_new == g_old) — until ġ
+ * has grown enough for a rounding to fall the other way. Near a point where ġ vanishes on the
+ * surface (a kink θ = d met with θ̇ → 0, as in a Zeno accumulation at the intersection of the
+ * surfaces θ = d and θ̇ = 0) that takes thousands of steps of 1e-10 s at every approach, far
+ * more than the accumulation itself: its crossings then drift apart beyond zeno_dt, the Zeno
+ * test never fires, and the step budget runs out. Such a step (g unchanged, approaching, within
+ * the rounding) is taken as reaching the surface: x_ev is x moved across it by the fewest units
+ * of rounding of the coordinate that moves g most — a change of the state of the size of one
+ * step's rounding error. Returns the surface index (x_ev strictly on the far side), or −1. */
+static int stuck_at_switch(int mode, double t, const double *x, const double *p, int n, const double *g_old,
+                           const double *g, const double *gd, double *x_ev) {
+    for (int k = MODE_NTR[mode]; k < n_surf(mode); ++k) {
+        if (!(g[k] == g_old[k] && g[k] * gd[k] < 0.0 && fabs(g[k]) > DBL_MIN)) continue;
+        double e[NXMAX], g0[NTR1], gi[NTR1], res = 0.0, best = 0.0, dir = 0.0;
+        int ib = -1;
+        for (int j = 0; j < n; ++j) e[j] = 0.0;
+        surfaces_dot(mode, t, x, e, p, g0); /* ∂g/∂t, taken out of each directional derivative */
+        for (int i = 0; i < n; ++i) {
+            e[i] = 1.0;
+            surfaces_dot(mode, t, x, e, p, gi);
+            e[i] = 0.0;
+            const double dg = gi[k] - g0[k], unit = fabs(nextafter(x[i], INFINITY) - x[i]);
+            res += 4.0 * DBL_EPSILON * fabs(dg * x[i]);
+            if (fabs(dg) * unit > best) { best = fabs(dg) * unit; ib = i; dir = (g[k] > 0.0) == (dg > 0.0) ? -INFINITY : INFINITY; }
+        }
+        if (ib < 0 || fabs(g[k]) > res) continue;
+        double gs[NTR1];
+        for (int j = 0; j < n; ++j) x_ev[j] = x[j];
+        for (int it = 0; it < 64; ++it) {
+            x_ev[ib] = nextafter(x_ev[ib], dir);
+            surfaces(mode, t, x_ev, p, gs);
+            if (gs[k] * g[k] < 0.0) return k;
+        }
+    }
+    return -1;
+}
+
 /* Side a surface is on before it crosses in direction dir (0: the side of g0), as ±1. */
 static double pre_side(int dir, double g0) { return dir < 0 ? 1.0 : dir > 0 ? -1.0 : (g0 >= 0.0 ? 1.0 : -1.0); }
 
