@@ -118,7 +118,9 @@ def test_swings_shrinking_onto_a_kink_with_almost_balanced_gravity_end_as_zeno_a
     a, span = 25.0 + 9.81 + 2.0, 4 * _BUDGET.zeno_dt
     th, thd = tr.final_state
     assert abs(thd) < a * span and abs(th - 0.2109375) < a * span**2
-    # and it ends where the swings accumulate, at most the cycles still to come (a geometric
-    # tail of the last cycle < 4 zeno_dt, ratio ~0.1) before it
+    # and it ends where the swings accumulate: before it by the cycles still to come (a geometric
+    # tail of the last cycle < 4 zeno_dt, ratio ~0.1: < 0.5 µs), shifted either way by state
+    # errors of rounding size on the last crawls (δθ ~ 1e-15 above the kink takes
+    # √(2 δθ / (g sin d − f)) ≈ 0.2 µs to come down); the stall ended 9 µs after it
     t_rest = _accumulation_time(25.0, 0.2109375, 2.0)
-    assert 0.0 <= t_rest - tr.t[-1] < 0.2 * span, (t_rest, tr.t[-1])
+    assert abs(t_rest - tr.t[-1]) < 0.25 * span, (t_rest, tr.t[-1])
