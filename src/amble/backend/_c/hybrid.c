@@ -170,6 +170,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             double fm[NXMAX];
             if (sens && (st = sens_to_event(&s, mode, p, t, s.y_old, t_ev, x_ev, 1, sens, fm))) { status = st; break; }
             t = t_ev;
+            onto_far_side(mode, ev_k, t, x_ev, p, s.n, from);
             for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
             if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
             if (sens && (st = sens_jump(mode, ev_k, -1, mode, t_ev, x_ev, p, fm, s.f_old, 0, sens))) { status = st; break; }
