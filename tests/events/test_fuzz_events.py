@@ -3,6 +3,7 @@ budget that none exceeds — every case ends with a status of its own (end_time,
 terminal), never by exhausting the budget, and energy is conserved between events where the
 force is conservative."""
 
+import pytest
 import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -79,3 +80,49 @@ def test_marginal_coulomb_sticking_is_detected_as_sliding():
     th, thd = tr.final_state
     assert abs(thd) < 1e-6
     assert 9.81 * abs(__import__("math").sin(th)) + 0.375 < 8.0  # static friction can hold it there
+
+
+def _accumulation_time(k2: float, d: float, f: float, g: float = 9.81) -> float:
+    """The time the swings of the kink test come to rest, from SciPy: from rest below the kink
+    the motion alternates crossing θ = d and turning (θ̇ = 0), each segment one smooth branch
+    integrated by solve_ivp to its single event; the shrinking cycles (4 events) are summed as a
+    geometric series once a cycle is shorter than 1e-5 s."""
+    import numpy as np
+    from scipy.integrate import solve_ivp
+
+    t, x, above, up, times = 0.0, np.array([0.0, 0.0]), False, True, []
+    while not (len(times) > 8 and times[-1] - times[-5] < 1e-5):
+        tau = (0.0 if above else k2) - f * (1.0 if up else -1.0)
+        kink = len(times) % 2 == 0
+        event = (lambda _t, y: y[0] - d) if kink else (lambda _t, y: y[1])
+        event.terminal = True
+        sol = solve_ivp(lambda _t, y, tau=tau: [y[1], -g * np.sin(y[0]) + tau], (t, 10.0), x, method="DOP853",
+                        rtol=1e-13, atol=1e-15, events=event)
+        t, x = sol.t_events[0][0], sol.y_events[0][0]
+        above, up = (not above, up) if kink else (above, not up)
+        times.append(t)
+    r = (times[-1] - times[-5]) / (times[-5] - times[-9])
+    return times[-1] + (times[-1] - times[-5]) * r / (1.0 - r)
+
+
+@pytest.mark.parametrize("k2, d", [(25.0, 0.2109375), (5.0, 0.206)])
+def test_swings_shrinking_onto_a_kink_with_almost_balanced_gravity_end_as_zeno_at_rest(k2, d):
+    # τ = k2 below θ = d, 0 above, friction 2 sign(θ̇): above the kink gravity 9.81 sin d = 2.05
+    # (2.007) barely beats friction, so each swing comes back down onto θ = d at a crawl (θ̇ ~ 5e-8
+    # one rounding unit above it). That approach used to stall: ~4000 steps of 2.5e-10 s each,
+    # which spread the crossings beyond zeno_dt and spent the step budget ("stalled ... stiff").
+    params = {"k1": 0.0, "k2": k2, "c": 0.0, "d": d, "f": 2.0, "A": 1.0}
+    tr = amble.simulate(_system(), [0.0, 0.0], params=params, t_end=5.0, options=_BUDGET)
+    assert tr.status == "zeno", tr.message
+    # Zeno is declared when 5 events come less than zeno_dt apart: they span < 4 zeno_dt and
+    # include two turns (θ̇ = 0) and two kink crossings (θ = d), so with |θ̈| ≤ k2 + g + f the
+    # state is within a (4 zeno_dt) of rest and a (4 zeno_dt)² of the kink
+    a, span = k2 + 9.81 + 2.0, 4 * _BUDGET.zeno_dt
+    th, thd = tr.final_state
+    assert abs(thd) < a * span and abs(th - d) < a * span**2
+    # and it ends where the swings accumulate: before it by the cycles still to come (a geometric
+    # tail of the last cycle < 4 zeno_dt, ratio ~0.1: < 0.5 µs), shifted either way by state
+    # errors of rounding size on the last crawls (δθ ~ 1e-15 above the kink takes
+    # √(2 δθ / (g sin d − f)) ≈ 0.2 µs to come down); the stall ended 9 µs after it
+    t_rest = _accumulation_time(k2, d, 2.0)
+    assert abs(t_rest - tr.t[-1]) < 0.25 * span, (t_rest, tr.t[-1])

@@ -256,6 +256,79 @@ static int approaching_slide(int mode, double t, const double *x, const double *
     return -1;
 }
 
+/* x moved by the fewest units of rounding of its coordinate ib, in direction dir (±INFINITY),
+ * until surface k has the sign sgn (±1) strictly; returns 0, or −1 if 64 units do not do it. */
+static int nudge_across(int mode, int k, double t, const double *x, const double *p, int n, int ib, double dir,
+                        double sgn, double *x_out) {
+    double gs[NTR1];
+    for (int j = 0; j < n; ++j) x_out[j] = x[j];
+    for (int it = 0; it < 64; ++it) {
+        x_out[ib] = nextafter(x_out[ib], dir);
+        surfaces(mode, t, x_out, p, gs);
+        if (gs[k] * sgn > 0.0) return 0;
+    }
+    return -1;
+}
+
+/* The coordinate whose unit of rounding moves surface k most (returns it, or −1 if k depends on
+ * no coordinate), the direction that moves g towards sign sgn, and 4 ε Σᵢ |∂g/∂xᵢ| |xᵢ|. */
+static int steepest_unit(int mode, int k, double t, const double *x, const double *p, int n, double sgn,
+                         double *dir, double *res) {
+    double e[NXMAX], g0[NTR1], gi[NTR1], best = 0.0;
+    int ib = -1;
+    *res = 0.0;
+    for (int j = 0; j < n; ++j) e[j] = 0.0;
+    surfaces_dot(mode, t, x, e, p, g0); /* ∂g/∂t, taken out of each directional derivative */
+    for (int i = 0; i < n; ++i) {
+        e[i] = 1.0;
+        surfaces_dot(mode, t, x, e, p, gi);
+        e[i] = 0.0;
+        const double dg = gi[k] - g0[k], unit = fabs(nextafter(x[i], INFINITY) - x[i]);
+        *res += 4.0 * DBL_EPSILON * fabs(dg * x[i]);
+        if (fabs(dg) * unit > best) { best = fabs(dg) * unit; ib = i; *dir = (sgn > 0.0) == (dg > 0.0) ? INFINITY : -INFINITY; }
+    }
+    return ib;
+}
+
+/* A switching surface the arithmetic cannot reach. Approached (g ġ < 0) to within the rounding
+ * of the state, |g| ≤ 4 ε Σᵢ |∂g/∂xᵢ| |xᵢ|, it is no longer crossed by a step: a step long
+ * enough to move the state by one unit of rounding rounds some of its stages onto the far side,
+ * the jump of the right-hand side there fails the error test, and the steps accepted are those
+ * too short to move the state at all, so g keeps its value exactly (g_new == g_old) — until ġ
+ * has grown enough for a rounding to fall the other way. Near a point where ġ vanishes on the
+ * surface (a kink θ = d met with θ̇ → 0, as in a Zeno accumulation at the intersection of the
+ * surfaces θ = d and θ̇ = 0) that takes thousands of steps of 1e-10 s at every approach, far
+ * more than the accumulation itself: its crossings then drift apart beyond zeno_dt, the Zeno
+ * test never fires, and the step budget runs out. Such a step (g unchanged, approaching, within
+ * the rounding) is taken as reaching the surface: x_ev is x moved across it by the fewest units
+ * of rounding of the coordinate that moves g most — a change of the state of the size of one
+ * step's rounding error. Returns the surface index (x_ev strictly on the far side), or −1. */
+static int stuck_at_switch(int mode, double t, const double *x, const double *p, int n, const double *g_old,
+                           const double *g, const double *gd, double *x_ev) {
+    for (int k = MODE_NTR[mode]; k < n_surf(mode); ++k) {
+        if (!(g[k] == g_old[k] && g[k] * gd[k] < 0.0 && fabs(g[k]) > DBL_MIN)) continue;
+        const double sgn = g[k] > 0.0 ? -1.0 : 1.0;
+        double dir = 0.0, res;
+        const int ib = steepest_unit(mode, k, t, x, p, n, sgn, &dir, &res);
+        if (ib >= 0 && fabs(g[k]) <= res && nudge_across(mode, k, t, x, p, n, ib, dir, sgn, x_ev) == 0) return k;
+    }
+    return -1;
+}
+
+/* A switching surface crossed onto g = 0 exactly: the right-hand side there may be the branch of
+ * the side just left (Piecewise((a, g > 0), (b, True)) crossed upwards is b at g = 0), and the
+ * restarted step would mix both. The state is moved strictly onto the far side (nudge_across);
+ * `from`: the surface's value before the crossing. */
+static void onto_far_side(int mode, int k, double t, double *x, const double *p, int n, double from) {
+    double g[NTR1], x1[NXMAX], dir = 0.0, res;
+    surfaces(mode, t, x, p, g);
+    if (g[k] != 0.0 || from == 0.0) return;
+    const double sgn = from > 0.0 ? -1.0 : 1.0;
+    const int ib = steepest_unit(mode, k, t, x, p, n, sgn, &dir, &res);
+    if (ib >= 0 && nudge_across(mode, k, t, x, p, n, ib, dir, sgn, x1) == 0)
+        for (int j = 0; j < n; ++j) x[j] = x1[j];
+}
+
 /* Side a surface is on before it crosses in direction dir (0: the side of g0), as ±1. */
 static double pre_side(int dir, double g0) { return dir < 0 ? 1.0 : dir > 0 ? -1.0 : (g0 >= 0.0 ? 1.0 : -1.0); }
 

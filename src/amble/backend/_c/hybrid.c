@@ -113,6 +113,13 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             status = st;
             break;
         }
+        if (ev_k < 0 && nsf > ntr && (ev_k = stuck_at_switch(mode, t_new, s.y, p, s.n, g_old, g_new, gd_new, x_ev)) >= 0) {
+            /* a kink within the rounding of the state, approached but out of reach of any step:
+             * crossed at the step's end, as if located there */
+            t_ev = t_new;
+            from = g_new[ev_k];
+            if (sens && dop_dense_prepare(&s, mode, p)) { status = ST_SINGULAR_MASS; break; }
+        }
         const double t_stop = ev_k >= 0 ? t_ev : t_new;
         /* --- how many rows this step writes; if they do not fit, return and resume here --- */
         int64_t k0 = (int64_t)ctx[CX_GRID_K], k1 = k0;
@@ -163,6 +170,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             double fm[NXMAX];
             if (sens && (st = sens_to_event(&s, mode, p, t, s.y_old, t_ev, x_ev, 1, sens, fm))) { status = st; break; }
             t = t_ev;
+            onto_far_side(mode, ev_k, t, x_ev, p, s.n, from);
             for (int i = 0; i < s.n; ++i) s.y_old[i] = x_ev[i];
             if (rhs(mode, t, s.y_old, p, s.f_old)) { status = ST_SINGULAR_MASS; break; }
             if (sens && (st = sens_jump(mode, ev_k, -1, mode, t_ev, x_ev, p, fm, s.f_old, 0, sens))) { status = st; break; }
