@@ -263,12 +263,20 @@ def _message(r: Run, opts: Options, trs: list, switches: list) -> str:
 
 
 def _stiff_hint(r: Run, opts: Options) -> str:
-    """An explicit run that exhausted its step budget with tiny steps is most likely stiff: its
-    steps are bounded by stability, not accuracy (``ctx`` holds the next step size)."""
-    if opts.method != "dop853":
-        return ""
+    """Why a run exhausted its step budget: still crossing a switching surface in its last steps,
+    it chatters about the switch; otherwise an explicit run with tiny steps is most likely stiff
+    (its steps bounded by stability, not accuracy; ``ctx`` holds the next step size)."""
     h = float(r.ctx[CTX["H"]])
     mean = r.t / max(float(r.ctx[CTX["ISTEPS"]]), 1.0)
+    last = float(r.ctx[CTX["TPREV_EVENT"]])  # the last transition or switching-surface crossing
+    if 0 <= r.t - last < 1e3 * max(h, mean):
+        # crossings of a switching surface do not end the step budget: a run that still crossed
+        # one in its last steps chatters about it (a state-dependent switch that pushes the flow
+        # away on both sides oscillates with an amplitude of its own), which no integrator cures
+        return (f" (the state still crosses a switching surface, last at t = {last:.9g} s: it chatters "
+                f"about the switch, which a smaller step or another integrator does not cure)")
+    if opts.method != "dop853":
+        return ""
     if h > 0 and mean > 0 and h < 1e-4 * max(r.t, 1.0):
         return (f" (steps of ~{mean:.2g} s: the system looks stiff; try the implicit integrator, "
                 f"method='radau' / --method radau)")
