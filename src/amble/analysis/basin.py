@@ -23,10 +23,11 @@ from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import ConvergenceError, StateError
 from ..simulation.engine import Options, walk_many
+from .cells import TextRows, fmt_floats, fmt_ints
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
 from .section import Section
-from .sweep_runner import compiled, point_key, run_sweep
+from .sweep_runner import compiled, run_sweep
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -91,68 +92,79 @@ def _embed(k: Any, p: np.ndarray, section: tuple | None, idx: Sequence[int], S: 
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
                 base: list[float], fixed: list[float], to_state: Callable | None, steps: int, check_every: int,
                 tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None,
-                threads: int = 1) -> list[dict[str, Any]]:
-    """One or more grid rows: walk each cell with the compiled run loop, no recording.
+                threads: int = 1) -> TextRows:
+    """One or more grid rows: walk each cell with the compiled run loop, no recording; the rows
+    of the result file, already as text (:class:`~amble.analysis.cells.TextRows`).
 
     ``to_state`` ``None``: cells are put on the section (``section``: transition, time, pre-impact
-    state and the section coordinates; built here, in the worker, from the compiled kernels)."""
+    state and the section coordinates; built here, in the worker, from the compiled kernels).
+    Python work per cell is kept to a few vectorised passes over the task's block: the GIL it
+    holds is what keeps threads (and a Dask client receiving rows) from scaling with cores."""
     k = build(system, derivatives=section is not None)
     mi = 0
     n = k.meta["nx"][mi]
     p = np.asarray(pvec, float)
-    xs = np.asarray(fixed, float)
     b0 = np.asarray(base, float)
     opts = Options(rtol=rtol, atol=atol, max_step_time=system.max_step_time)
-    cells = []  # (i, a, j, b, state or None, reason it has none)
+    nb = len(b_values)
+    ii = np.repeat(np.array([i for i, _ in rows], dtype=np.int64), nb)  # the cells, row by row
+    aa = np.repeat(np.array([a for _, a in rows], dtype=float), nb)
+    jj = np.tile(np.arange(nb, dtype=np.int64), len(rows))
+    bb = np.tile(np.asarray(b_values, dtype=float), len(rows))
+    m = len(ii)
+    x0 = np.full((m, n), np.nan)
+    why = [""] * m  # why a cell has no initial state
     if to_state is None and section is not None:
         # the default embedding on the section: every cell's Newton solve in one compiled call
         # (the GIL released, shared by the threads), not one Python iteration per cell
         idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
-        grid = [(i, a, j, b) for i, a in rows for j, b in enumerate(b_values)]
-        raw = np.tile(b0, (len(grid), 1))
-        raw[:, idx[0]] = [g[1] for g in grid]
-        raw[:, idx[1]] = [g[3] for g in grid]
-        sec = Section(k, p, *section[:3])
-        for (i, a, j, b), x in zip(grid, sec.project_many(raw, section[3], threads=threads)):
+        raw = np.tile(b0, (m, 1))
+        raw[:, idx[0]], raw[:, idx[1]] = aa, bb
+        for c, x in enumerate(Section(k, p, *section[:3]).project_many(raw, section[3], threads=threads)):
             if x is None:  # no state of the section has these two coordinates here
-                cells.append((i, a, j, b, None, "off the section"))
-                continue
-            # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite
-            ok = x.shape == (n,) and math.isfinite(float(x.sum()))
-            cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
+                why[c] = "off the section"
+            else:
+                x0[c] = x
+        # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite
+        bad = ~np.isfinite(x0.sum(axis=1))
     else:
         if to_state is None:
             idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
             to_state = _embed(k, p, None, idx, [])
-        for i, a in rows:
-            for j, b in enumerate(b_values):
-                try:
-                    x = np.asarray(to_state(a, b, b0), float)
-                except ConvergenceError:  # no state of the section has these two coordinates here
-                    cells.append((i, a, j, b, None, "off the section"))
-                    continue
-                ok = x.shape == (n,) and bool(np.all(np.isfinite(x)))
-                cells.append((i, a, j, b, x if ok else None, "" if ok else "invalid initial state"))
-    # every valid cell of the task in one compiled call (amble_walk_batch): the walks and their
-    # convergence checks run in C with the GIL released, so threads and workers scale with cores
-    valid = [c for c in cells if c[4] is not None]
-    walks = walk_many(k, p, mi, np.array([c[4] for c in valid]).reshape(len(valid), n), xs, steps=steps,
-                      check_every=check_every, tol=tol, opts=opts, threads=threads) if valid else None
-    result = {(c[0], c[2]): w for w, c in enumerate(valid)}
-    out = []
-    for i, a, j, b, _x, why in cells:
-        w = result.get((i, j))
-        if w is None:
-            code, reason, done, dist = 3, why, 0, math.nan
-        else:
-            done, dist, status = int(walks["steps"][w]), float(walks["distance"][w]), walks["status"][w]
-            if walks["code"][w] != CODE["STEPS_DONE"]:
-                code, reason = (1 if status == "fell" else 3), status
+        bad = np.zeros(m, dtype=bool)
+        for c, (a, b) in enumerate(zip(aa.tolist(), bb.tolist())):
+            try:
+                x = np.asarray(to_state(a, b, b0), float)
+            except ConvergenceError:  # no state of the section has these two coordinates here
+                why[c] = "off the section"
+                continue
+            if x.shape == (n,) and bool(np.all(np.isfinite(x))):
+                x0[c] = x
             else:
-                code, reason = (0 if dist < tol else 2), ""
-        out.append({"i": i, "j": j, x_names[0]: float(a), x_names[1]: float(b), "outcome": BASIN_LABELS[code],
-                    "reason": reason, "steps": done, "distance": dist})
-    return out
+                bad[c] = True
+    for c in np.flatnonzero(bad).tolist():
+        why[c] = why[c] or "invalid initial state"
+    valid = np.flatnonzero(~bad & np.array([w == "" for w in why], dtype=bool))
+    code = np.full(m, 3, dtype=np.int64)  # failed, unless walked
+    done = np.zeros(m, dtype=np.int64)
+    dist = np.full(m, math.nan)
+    if len(valid):
+        # every valid cell of the task in one compiled call (amble_walk_batch): the walks and their
+        # convergence checks run in C with the GIL released, so threads and workers scale with cores
+        walks = walk_many(k, p, mi, x0[valid], np.asarray(fixed, float), steps=steps, check_every=check_every,
+                          tol=tol, opts=opts, threads=threads)
+        finished = walks["code"] == CODE["STEPS_DONE"]
+        fell = np.array([st == "fell" for st in walks["status"]], dtype=bool)
+        d = walks["distance"]
+        code[valid] = np.where(finished, np.where(d < tol, 0, 2), np.where(fell, 1, 3))
+        done[valid], dist[valid] = walks["steps"], d
+        for c, st, f in zip(valid.tolist(), walks["status"], finished.tolist()):
+            if not f:
+                why[c] = st
+    cols = {"i": fmt_ints(ii), "j": fmt_ints(jj), x_names[0]: fmt_floats(aa), x_names[1]: fmt_floats(bb),
+            "outcome": [BASIN_LABELS[c] for c in code.tolist()], "reason": why, "steps": fmt_ints(done),
+            "distance": fmt_floats(dist)}
+    return TextRows(zip(*(cols[c] for c in basin_columns(x_names))))
 
 
 def basin(
@@ -226,7 +238,9 @@ def basin(
             raise StateError(f"basin: {x_names[0]} and {x_names[1]} are tied on the section (they cannot both be "
                              f"varied); section coordinates of this model: {free}") from None
         section = (sec.tr, sec.t, sec.pre.tolist(), S.tolist())
-    keys = [[point_key(i, j, float(a), float(b)) for j, b in enumerate(bv)] for i, a in enumerate(av)]
+    # the cells' keys (as :func:`point_key` writes them), each column's text made once
+    ti, tj, ta, tb = fmt_ints(range(len(av))), fmt_ints(range(len(bv))), fmt_floats(av), fmt_floats(bv)
+    keys = [[(ti[i], tj[j], ta[i], tb[j]) for j in range(len(bv))] for i in range(len(av))]
 
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
@@ -236,20 +250,17 @@ def basin(
                     groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,
                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
                     params=list(x_names), state_names=snames)
-    stored = {(int(r["i"]), int(r["j"])): r for r in res.rows}
     outcome = np.full((len(av), len(bv)), -1, dtype=int)
     st = np.zeros((len(av), len(bv)), dtype=int)
     dist = np.full((len(av), len(bv)), math.nan)
     why = np.full((len(av), len(bv)), "", dtype=object)
-    for i in range(len(av)):
-        for j in range(len(bv)):
-            r = stored.get((i, j))
-            if r is None:
-                continue
-            outcome[i, j] = BASIN_LABELS.index(r["outcome"])
-            st[i, j] = int(r["steps"])
-            dist[i, j] = float(r["distance"]) if r["distance"] not in ("", "nan") else math.nan
-            why[i, j] = r["reason"]
+    if res.rows:  # column by column: one pass over the rows for each
+        at = (np.array([int(r["i"]) for r in res.rows]), np.array([int(r["j"]) for r in res.rows]))
+        label = {lab: c for c, lab in enumerate(BASIN_LABELS)}
+        outcome[at] = [label[r["outcome"]] for r in res.rows]
+        st[at] = [int(r["steps"]) for r in res.rows]
+        dist[at] = [float(r["distance"]) if r["distance"] else math.nan for r in res.rows]
+        why[at] = [r["reason"] for r in res.rows]
     return BasinResult(names=tuple(x_names), a_values=av, b_values=bv, outcome=outcome, steps=st, distance=dist,
                        fixed_point=xs, path=str(out) if out else None, computed=res.computed,
                        state_names=snames, reasons=why)

@@ -25,19 +25,20 @@ from __future__ import annotations
 import csv
 import errno
 import io
-import json
 import math
 import os
 import tempfile
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import OutputError
+from .cells import COLUMN_TYPES, TextRows, fmt_value, parse_value
 
 
 class ResultFileWarning(UserWarning):
@@ -73,6 +74,9 @@ class ResultStore:
         self.columns = list(columns)
         self.types: dict[str, str] = dict(columns) if isinstance(columns, Mapping) else {}
         self.key = list(key)
+        at = [self.columns.index(c) for c in self.key]
+        # the key of a row given as its cells in column order (a tuple, also for one key column)
+        self._key_of = itemgetter(*at) if len(at) > 1 else (lambda t, i=at[0]: (t[i],))
         self.ignored = 0  # rows of the file that were not of their columns' types
         self._first_ignored = ""
         self.final: Path | None = Path(path) if path is not None else None
@@ -199,13 +203,28 @@ class ResultStore:
         """Whether the point with this key is already stored."""
         return key in self.rows
 
-    def append(self, rows: Iterable[Mapping[str, Any]]) -> None:
-        """Add rows (values formatted exactly); durable on return when the store has a file."""
+    def append(self, rows: Iterable[Mapping[str, Any]] | TextRows) -> None:
+        """Add rows (values formatted exactly, :func:`~amble.analysis.cells.fmt_value`); durable
+        on return when the store has a file. :class:`~amble.analysis.cells.TextRows` (cells
+        already as text, in column order) are appended as they are."""
+        if isinstance(rows, TextRows):
+            self.append_text(rows)
+            return
+        self.append_text([tuple(fmt_value(r.get(c, "")) for c in self.columns) for r in rows])
+
+    def append_text(self, rows: Iterable[Sequence[str]]) -> None:
+        """Add rows whose cells are already text (:func:`~amble.analysis.cells.fmt_value`), in
+        column order; a row whose key is stored already is skipped (the first of a key wins).
+        Durable on return (one ``write`` and ``fsync`` for all of them)."""
         fresh = []
-        for r in rows:
-            s = {c: fmt_value(r.get(c, "")) for c in self.columns}
-            if self._add(s):
-                fresh.append(s)
+        ncol, cols = len(self.columns), self.columns
+        for t in rows:
+            if len(t) != ncol:
+                raise ValueError(f"a row of {len(t)} cells for the {ncol} columns {', '.join(cols)}")
+            k = self._key_of(t)
+            if k not in self.rows:
+                self.rows[k] = dict(zip(cols, t))
+                fresh.append(t)
         if self.journal is None or not fresh:
             return
         new = not self.journal.exists() or self.journal.stat().st_size == 0
@@ -213,8 +232,7 @@ class ResultStore:
         w = csv.writer(buf, lineterminator="\n")
         if new:
             w.writerow(self.columns)
-        for s in fresh:
-            w.writerow([s[c] for c in self.columns])
+        w.writerows(fresh)
         size = self.journal.stat().st_size if not new else 0
         try:
             with open(self.journal, "a", newline="", encoding="utf-8") as f:
@@ -222,8 +240,8 @@ class ResultStore:
                 f.flush()
                 os.fsync(f.fileno())
         except OSError as e:
-            for s in fresh:  # not durable: the points are still pending
-                self.rows.pop(tuple(s[c] for c in self.key), None)
+            for t in fresh:  # not durable: the points are still pending
+                self.rows.pop(self._key_of(t), None)
             try:  # the journal as it was: no torn rows of this write
                 os.truncate(self.journal, size)
             except OSError:
@@ -235,11 +253,12 @@ class ResultStore:
         """All stored rows, sorted by key."""
         return [self.rows[k] for k in sorted(self.rows, key=_sort_key)]
 
-    def compact(self) -> None:
-        """Rewrite the file sorted by key, atomically (deterministic content for equal results)."""
+    def compact(self, rows: list[dict[str, str]] | None = None) -> None:
+        """Rewrite the file sorted by key, atomically (deterministic content for equal results).
+        ``rows``: :meth:`sorted_rows`, when the caller has them already."""
         if self.final is None:
             return
-        rows = self.sorted_rows()
+        rows = self.sorted_rows() if rows is None else rows
         tmp = self.final.with_name(f".{self.final.name}.{os.getpid()}.tmp")
         try:
             self._write_compacted(rows, tmp)
@@ -319,18 +338,6 @@ def _lock(final: Path) -> Any:
     return f
 
 
-def fmt_value(v: Any) -> str:
-    """A cell as text: floats by ``repr`` (round-trips exactly, so a seed read back from the file
-    is bit-identical), booleans ``true``/``false``, ``None`` empty."""
-    if isinstance(v, bool) or v is None:
-        return "" if v is None else str(v).lower()
-    if isinstance(v, (float, np.floating)):
-        return repr(float(v))
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    return str(v)
-
-
 def _sort_key(k: tuple[str, ...]) -> tuple:
     # integer key fields (grid indices) sort numerically, so row 10 follows row 9
     return tuple(int(x) if x.lstrip("-").isdigit() else x for x in k)
@@ -348,28 +355,6 @@ def state_from_row(row: Mapping[str, str], names: Sequence[str]) -> np.ndarray |
     except (KeyError, ValueError):
         return None
     return x if np.all(np.isfinite(x)) else None
-
-
-#: Column types of sweep rows: how :meth:`SweepResult.records` reads a stored text cell back
-#: (an empty cell is ``None``, or NaN for ``float``).
-COLUMN_TYPES = ("int", "float", "bool", "str", "json")
-
-
-def parse_value(text: str, kind: str) -> Any:
-    """A stored cell (:func:`fmt_value`) back as a value of the column type ``kind``."""
-    if kind == "str":
-        return text
-    if text == "":
-        return math.nan if kind == "float" else None
-    if kind == "float":
-        return float(text)
-    if kind == "int":
-        return int(text)
-    if kind == "bool":
-        return text == "true"
-    if kind == "json":
-        return json.loads(text)
-    raise ValueError(f"unknown column type {kind!r}; known: {', '.join(COLUMN_TYPES)}")
 
 
 @dataclass

@@ -98,10 +98,12 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
         finally:
             close()
         complete = all(store.has(kk) for kk in flat)
+        rows = store.sorted_rows()  # sorted once, for the file and the result
         if complete:
-            store.compact()
-        wanted = set(flat)
-        rows = [r for r in store.sorted_rows() if tuple(r[c] for c in key) in wanted]
+            store.compact(rows)
+        if sum(1 for kk in flat if kk in store.rows) != len(store.rows):  # rows outside the grid: left out
+            wanted = set(flat)
+            rows = [r for r in rows if tuple(r[c] for c in key) in wanted]
         return SweepResult(kind=kind, params=list(params), rows=rows, path=str(out) if out else None, complete=complete,
                            computed=computed, reused=len(flat) - missing, state_names=list(state_names),
                            types=dict(columns))
