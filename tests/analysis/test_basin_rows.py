@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import math
 import struct
+import time
 
 import numpy as np
 import pytest
@@ -149,10 +150,14 @@ def test_resumed_basin_on_two_threads_equals_uninterrupted_one(compass, walker, 
         np.testing.assert_array_equal(getattr(second, name), getattr(full, name))
 
 
-def test_rows_of_finished_tasks_stay_when_a_later_task_fails(compass, walker, tmp_path):
-    _, _, xs = walker
+@pytest.mark.parametrize("threads", [1, 2])
+def test_rows_of_finished_tasks_stay_when_a_later_task_fails(compass, tmp_path, threads):
+    """On two threads, tasks run side by side: a failing task drops the tasks not started, but
+    the one still running is finished and its rows are kept."""
 
     def to_state(a, b, base):
+        if abs(a + 0.25) < 1e-9 and b == 0.9:
+            time.sleep(0.3)  # row 1 is still running when row 2 (started after row 0) fails
         if a > -0.22:
             raise OutputError("a user's embedding that fails on the later rows")
         return _on_slope(a, b, base)
@@ -160,9 +165,9 @@ def test_rows_of_finished_tasks_stay_when_a_later_task_fails(compass, walker, tm
     out = tmp_path / "basin.csv"
     args = (("stance", "stance_dot"), ((-0.3, -0.1), (0.9, 1.3)), (5, 4))
     with pytest.raises(OutputError, match="later rows"):
-        basin(compass, *args, to_state=to_state, steps=10, rows_per_task=1, out=out, **SYNC)
+        basin(compass, *args, to_state=to_state, steps=10, rows_per_task=1, out=out, threads=threads, **SYNC)
     with open(out, newline="") as f:
-        done = [(int(r["i"]), int(r["j"])) for r in csv.DictReader(f)]
+        done = sorted((int(r["i"]), int(r["j"])) for r in csv.DictReader(f))
     assert done == [(i, j) for i in range(2) for j in range(4)]  # stance −0.3 and −0.25: rows 0 and 1
     again = basin(compass, *args, to_state=_on_slope, steps=10, rows_per_task=1, out=out, **SYNC)
     assert again.computed == 12  # the finished rows are not walked again

@@ -203,10 +203,12 @@ def basin(
     ``|x − x*|∞ < tol``, ``fell`` if a terminal/fall event ended it, ``not converged`` if it kept
     walking elsewhere (another attractor or too slow), ``failed`` for any other run status.
     One Dask task per ``rows_per_task`` grid rows. ``rtol``/``atol``: integrator tolerances
-    (looser than for fixed points: only the outcome category matters here). ``threads``: each
-    task's walks share this many threads of its process (with ``scheduler='synchronous'``: this
-    process) — the compiled walks release the GIL and take cells one by one, so two threads on
-    two cores walk a map in about half the time; the result does not depend on it.
+    (looser than for fixed points: only the outcome category matters here). ``threads``: with
+    ``scheduler='synchronous'``, this many tasks run side by side on threads of this process
+    (one task's Python work overlaps the others' compiled walks, which release the GIL), or, for a
+    grid of one task, its walks share them; on Dask, each task's walks share this many threads of
+    its worker. Two threads on two cores walk a map in about half the time; the result does not
+    depend on it (each cell is walked whole by one thread; the compacted file is sorted by key).
     """
     from .poincare import ReturnMap, find_fixed_point
 
@@ -242,14 +244,19 @@ def basin(
     ti, tj, ta, tb = fmt_ints(range(len(av))), fmt_ints(range(len(bv))), fmt_floats(av), fmt_floats(bv)
     keys = [[(ti[i], tj[j], ta[i], tb[j]) for j in range(len(bv))] for i in range(len(av))]
 
+    # in this process, with two or more tasks, the threads run whole tasks side by side (the Python
+    # part of one overlaps the compiled walks of another); else they share each task's walks
+    side_by_side = scheduler == "synchronous" and threads > 1 and len(av) > rows_per_task
+    per_task = 1 if side_by_side else threads
+
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
-                to_state, steps, check_every, tol, rtol, atol, list(x_names), section, threads)
+                to_state, steps, check_every, tol, rtol, atol, list(x_names), section, per_task)
 
     res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
                     groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,
                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
-                    params=list(x_names), state_names=snames)
+                    params=list(x_names), state_names=snames, threads=threads if side_by_side else 1)
     outcome = np.full((len(av), len(bv)), -1, dtype=int)
     st = np.zeros((len(av), len(bv)), dtype=int)
     dist = np.full((len(av), len(bv)), math.nan)

@@ -131,10 +131,12 @@ def _check_scheduler(address: str) -> None:
 
 
 def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, progress: bool, total: int,
-            desc: str) -> None:
+            desc: str, threads: int = 1) -> None:
     """Submit ``fn(*task)`` for each task; append each returned row list to the store as it lands.
 
-    Every task's first argument is the same :class:`HybridSystem`."""
+    Every task's first argument is the same :class:`HybridSystem`. In this process
+    (``scheduler='synchronous'``), ``threads`` > 1 runs that many tasks at once on threads of this
+    process (:func:`_pooled`)."""
     if not tasks:
         return
     from tqdm.auto import tqdm
@@ -142,6 +144,9 @@ def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, p
     bar = tqdm(total=total, desc=desc, unit="pt", disable=not progress, leave=False)
     try:
         if isinstance(client, _Serial):
+            if threads > 1 and len(tasks) > 1:
+                _pooled(fn, tasks, store, bar, threads)
+                return
             for t in tasks:
                 rows = fn(*t)
                 store.append(rows)
@@ -158,6 +163,45 @@ def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, p
             bar.update(len(rows))
     finally:
         bar.close()
+
+
+def _pooled(fn: Callable, tasks: list[tuple], store: ResultStore, bar: Any, threads: int) -> None:
+    """Run the tasks on ``threads`` threads of this process, appending each one's rows from this
+    thread as it finishes.
+
+    Why tasks side by side rather than one task's walks shared by threads: the Python part of a
+    task (building its states, its rows as text) holds the GIL, but it overlaps the compiled walks
+    of the other tasks (which release it) instead of leaving the other core idle. Should a task
+    fail (or the run be interrupted), the tasks not started are dropped, those running are
+    finished and their rows appended, then the first error is raised: no finished work is lost."""
+    from concurrent.futures import ThreadPoolExecutor, as_completed
+
+    error: BaseException | None = None
+    pool = ThreadPoolExecutor(min(threads, len(tasks)), thread_name_prefix="amble-sweep")
+    futures = [pool.submit(fn, *t) for t in tasks]
+    pending = set(futures)
+    while pending:
+        try:
+            for fut in as_completed(pending):
+                pending.discard(fut)
+                if fut.cancelled():
+                    continue
+                exc = fut.exception()
+                if exc is not None:
+                    raise exc
+                rows = fut.result()
+                store.append(rows)
+                bar.update(len(rows))
+        except BaseException as e:  # a task's error, Ctrl-C, or a failed append
+            if error is None:
+                error = e
+                for f in pending:
+                    f.cancel()
+            elif isinstance(e, KeyboardInterrupt):  # interrupted again while finishing: stop waiting
+                break
+    pool.shutdown(wait=not isinstance(error, KeyboardInterrupt), cancel_futures=True)
+    if error is not None:
+        raise error
 
 
 # ---------------------------------------------------------------------------- grid helpers

@@ -251,7 +251,8 @@ class ResultStore:
 
     def sorted_rows(self) -> list[dict[str, str]]:
         """All stored rows, sorted by key."""
-        return [self.rows[k] for k in sorted(self.rows, key=_sort_key)]
+        field = _SortField()  # a grid's keys repeat few field texts: each is converted once
+        return [self.rows[k] for k in sorted(self.rows, key=lambda k: tuple(map(field.__getitem__, k)))]
 
     def compact(self, rows: list[dict[str, str]] | None = None) -> None:
         """Rewrite the file sorted by key, atomically (deterministic content for equal results).
@@ -338,9 +339,13 @@ def _lock(final: Path) -> Any:
     return f
 
 
-def _sort_key(k: tuple[str, ...]) -> tuple:
-    # integer key fields (grid indices) sort numerically, so row 10 follows row 9
-    return tuple(int(x) if x.lstrip("-").isdigit() else x for x in k)
+class _SortField(dict):
+    """Key field text → what it sorts as: integer fields (grid indices) numerically, so row 10
+    follows row 9; others as text. Filled on first use of each text."""
+
+    def __missing__(self, x: str) -> int | str:
+        v = self[x] = int(x) if x.lstrip("-").isdigit() else x
+        return v
 
 
 def state_columns(names: Sequence[str]) -> list[str]:

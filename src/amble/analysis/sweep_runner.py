@@ -63,7 +63,7 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
               groups: Sequence[Sequence[int]], make_task: Callable[[list[int], Sequence[int], ResultStore], tuple],
               fn: Callable[..., list[dict[str, Any]]], out: str | os.PathLike | None, scheduler: Any,
               workers: int | None, progress: bool, max_points: int | None, split: int | None = None,
-              params: Sequence[str] = (), state_names: Sequence[str] = ()) -> SweepResult:
+              params: Sequence[str] = (), state_names: Sequence[str] = (), threads: int = 1) -> SweepResult:
     """Run the pending points of a sweep and return every stored row of its grid, sorted by key.
 
     ``columns``: column name → type (:data:`amble.analysis.store.COLUMN_TYPES`), in file order;
@@ -71,7 +71,9 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
     missing); ``groups``: the chunks of point indices. The pending points of a group, cut to the
     budget (``max_points`` keys) and into runs of ``split`` points (default: all), become the
     task ``make_task(points, group, store)``, run as ``fn(*task)``. ``computed`` / ``reused``
-    of the result count keys.
+    of the result count keys. ``threads``: with ``scheduler='synchronous'``, tasks run this many
+    at a time on threads of this process (:func:`amble.analysis.runner.execute`); the journal's
+    rows are then in the order tasks finish, the compacted file sorted as always.
     """
     # the column types let the store ignore a damaged row instead of counting it ok
     with ResultStore(out, dict(columns), key) as store:  # holds the file's lock until the end
@@ -94,7 +96,7 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
         computed = n_sched * per
         client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
         try:
-            execute(client, fn, tasks, store, progress, computed, kind)
+            execute(client, fn, tasks, store, progress, computed, kind, threads=threads)
         finally:
             close()
         complete = all(store.has(kk) for kk in flat)
