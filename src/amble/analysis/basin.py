@@ -109,7 +109,6 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     nb = len(b_values)
     ii = np.repeat(np.array([i for i, _ in rows], dtype=np.int64), nb)  # the cells, row by row
     aa = np.repeat(np.array([a for _, a in rows], dtype=float), nb)
-    jj = np.tile(np.arange(nb, dtype=np.int64), len(rows))
     bb = np.tile(np.asarray(b_values, dtype=float), len(rows))
     m = len(ii)
     x0 = np.full((m, n), np.nan)
@@ -120,11 +119,10 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
         idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
         raw = np.tile(b0, (m, 1))
         raw[:, idx[0]], raw[:, idx[1]] = aa, bb
-        for c, x in enumerate(Section(k, p, *section[:3]).project_many(raw, section[3], threads=threads)):
-            if x is None:  # no state of the section has these two coordinates here
-                why[c] = "off the section"
-            else:
-                x0[c] = x
+        on = Section(k, p, *section[:3]).project_many(raw, section[3], threads=threads)
+        for c in [c for c, x in enumerate(on) if x is None]:  # no state of the section has these coordinates
+            why[c] = "off the section"
+        x0 = np.array([x0[0] if x is None else x for x in on])  # one pass in C (x0[0]: a row of NaN)
         # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite
         bad = ~np.isfinite(x0.sum(axis=1))
     else:
@@ -161,7 +159,11 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
         for c, st, f in zip(valid.tolist(), walks["status"], finished.tolist()):
             if not f:
                 why[c] = st
-    cols = {"i": fmt_ints(ii), "j": fmt_ints(jj), x_names[0]: fmt_floats(aa), x_names[1]: fmt_floats(bb),
+    # a grid row's i and a, and the j and b of its columns, are the same text in every row: written once
+    ti, ta = fmt_ints([i for i, _ in rows]), fmt_floats([a for _, a in rows])
+    tj, tb = fmt_ints(range(nb)), fmt_floats(b_values)
+    cols = {"i": [t for t in ti for _ in range(nb)], "j": tj * len(rows),
+            x_names[0]: [t for t in ta for _ in range(nb)], x_names[1]: tb * len(rows),
             "outcome": [BASIN_LABELS[c] for c in code.tolist()], "reason": why, "steps": fmt_ints(done),
             "distance": fmt_floats(dist)}
     return TextRows(zip(*(cols[c] for c in basin_columns(x_names))))
