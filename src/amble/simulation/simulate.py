@@ -29,28 +29,61 @@ if TYPE_CHECKING:
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
                      ) -> np.ndarray:
     """Defaults overridden by ``params``; unknown names, non-finite values and (given the
-    ``system``) values outside a parameter's declared domain are :class:`ParameterError`."""
+    ``system``) values outside a parameter's declared domain are :class:`ParameterError`.
+    A new array on every call (callers keep it: a trajectory's ``params``)."""
+    key = _parameter_key(k, params)
+    hit = _PARAMETERS.get(key) if key is not None else None
+    if hit is not None and hit[0] is k:
+        if system is not None and hit[2]:
+            system.check_parameters(hit[2])  # domains are the system's: checked on every call
+        return hit[1].copy()
     names = k.meta["params"]
     p = np.array(k.meta["param_defaults"], dtype=float)
     if params is not None and not isinstance(params, Mapping):  # a list of pairs or of names reads ambiguously
         raise ParameterError(f"params must be a mapping of parameter names to values (e.g. {{'slope': 0.05}}), "
                              f"got a {type(params).__name__}")
+    given: dict[str, float] = {}
     if params:
-        for key, val in params.items():
-            if key not in names:
-                raise ParameterError(f"unknown parameter {key!r}; known: {', '.join(names)}")
+        for key_, val in params.items():
+            if key_ not in names:
+                raise ParameterError(f"unknown parameter {key_!r}; known: {', '.join(names)}")
             try:
                 v = float(val)
             except (TypeError, ValueError):
-                raise ParameterError(f"parameter {key!r} must be a number, got {val!r}") from None
+                raise ParameterError(f"parameter {key_!r} must be a number, got {val!r}") from None
             if not math.isfinite(v):
-                raise ParameterError(f"parameter {key!r} must be finite, got {val!r}")
-            p[names.index(key)] = v
+                raise ParameterError(f"parameter {key_!r} must be finite, got {val!r}")
+            p[names.index(key_)] = v
+        given = {key_: float(p[names.index(key_)]) for key_ in params}
         if system is not None:
-            system.check_parameters({key: float(p[names.index(key)]) for key in params})
+            system.check_parameters(given)
     if p.size == 0:
         p = np.zeros(1)
+    if key is not None:
+        if len(_PARAMETERS) >= 256:  # bounded: a sweep passes a new value on every call
+            _PARAMETERS.clear()
+        _PARAMETERS[key] = (k, p, given)
+        return p.copy()
     return p
+
+
+#: Parameter vectors by (id of the kernels, the overrides as given) → (kernels, vector, the
+#: overrides as checked against the domains): names, numbers and finiteness are checked once.
+_PARAMETERS: dict[tuple, tuple[Kernels, np.ndarray, dict[str, float]]] = {}
+
+
+def _parameter_key(k: Kernels, params: Any) -> tuple | None:
+    """The memo key of these overrides, or ``None`` (not memoised) unless every value is a plain
+    ``float`` or ``int``: two values that compare equal then convert to the same number."""
+    if not params:
+        return (id(k),) if params is None or type(params) is dict else None
+    if type(params) is not dict:
+        return None
+    items = tuple(params.items())
+    for _, v in items:
+        if type(v) is not float and type(v) is not int:
+            return None
+    return (id(k), *items)
 
 
 def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, mode: str | None
@@ -74,8 +107,9 @@ def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, 
         raise StateError(
             f"initial state has {x.size} values, mode {mode!r} needs {len(names)}: {', '.join(names)}"
         )
-    if not np.isfinite(x).all():
-        raise StateError(f"initial state is not finite: {x.tolist()}")
+    values = x.tolist()
+    if not all(map(math.isfinite, values)):  # a tenth of np.isfinite(x).all() on a short state
+        raise StateError(f"initial state is not finite: {values}")
     return mi, x
 
 
@@ -160,7 +194,8 @@ def simulate(
         raise
     traj = _trajectory(k, p, r, opts)
     if not samples:  # rows: where the run started and where it ended
-        rows = np.full((2, k.nx_max), np.nan)
+        rows = np.empty((2, k.nx_max))
+        rows.fill(np.nan)
         rows[0, : x.size], rows[1, : r.x.size] = x, r.x
         traj.t, traj.mode, traj.x = np.array([0.0, r.t]), np.array([mi, r.mode], dtype=np.int32), rows
     traj.system = system
