@@ -32,6 +32,10 @@ YIELD_STEPS = 20_000
 
 _CX_T, _CX_MODE, _CX_TLAST_STEP, _CX_GRID_T0 = CTX["T"], CTX["MODE"], CTX["TLAST_STEP"], CTX["GRID_T0"]
 _CX_TPREV_EVENT, _CX_FRESH = CTX["TPREV_EVENT"], CTX["FRESH"]
+_CX_INFO, _CX_STEPS, _CX_EVENTS = CTX["INFO"], CTX["STEPS"], CTX["EVENTS"]
+_YIELD, _BUFFER_FULL, _RECORD_LIMIT = CODE["YIELD"], CODE["BUFFER_FULL"], CODE["RECORD_LIMIT"]
+#: Codes whose ``ctx`` names the transition (or surface) that ended the run.
+_WITH_INFO = (CODE["TERMINAL"], CODE["RESET_FAILED"], CODE["SLIDING"])
 _OP_TEND, _OP_SAMPLEDT = OPT["TEND"], OPT["SAMPLEDT"]
 _IO_MAXSTEPS, _IO_OUTCAP, _IO_EVCAP = IOPT["MAXSTEPS"], IOPT["OUTCAP"], IOPT["EVCAP"]
 
@@ -191,21 +195,21 @@ def run(
         raise StateError(f"sensitivities need method='dop853', not {opts.method!r}")
     sens = _sensitivity_buffer(k, x0.size, sensitivities is True) if sensitivities else None
     sens_addr = sens.ctypes.data if sens is not None else None
-    code = CODE["YIELD"]
+    code = _YIELD
     try:
         while True:
             iopt[_IO_OUTCAP], iopt[_IO_EVCAP] = buf.cap, buf.ecap
             code = buf.call(k, p, ctx, opt, iopt, sens_addr)
-            if code == CODE["BUFFER_FULL"]:
+            if code == _BUFFER_FULL:
                 if buf.nbytes_grown() > budget:  # the run is resumable here: stop with what it has
-                    code = CODE["RECORD_LIMIT"]
+                    code = _RECORD_LIMIT
                     break
                 buf.grow()
-            elif code != CODE["YIELD"]:
+            elif code != _YIELD:
                 break
     except KeyboardInterrupt as exc:
         # Ctrl-C between two compiled calls: the run so far stays reachable as ``exc.run``
-        exc.run = _result(k, CODE["YIELD"], ctx, buf)  # type: ignore[attr-defined]
+        exc.run = _result(k, _YIELD, ctx, buf)  # type: ignore[attr-defined]
         raise
     r = _result(k, code, ctx, buf)
     if sens is not None:
@@ -267,12 +271,13 @@ def walk_many(k: Kernels, p: np.ndarray, mode: int, x0: np.ndarray, xref: np.nda
 
 
 def _result(k: Kernels, code: int, ctx: np.ndarray, buf: _Buffers) -> Run:
-    mi = int(ctx[CTX["MODE"]])
-    info = int(ctx[CTX["INFO"]]) if code in (CODE["TERMINAL"], CODE["RESET_FAILED"], CODE["SLIDING"]) else -1
-    status = "interrupted" if code == CODE["YIELD"] else outcome(k, code, info)
-    return Run(code=code, status=status, t=float(ctx[CTX["T"]]), mode=mi,
-               x=ctx[CTX_X : CTX_X + k.meta["nx"][mi]].copy(), steps=int(ctx[CTX["STEPS"]]),
-               events=int(ctx[CTX["EVENTS"]]), info=info, ctx=ctx, recorded=buf.result_and_release())
+    c = ctx[:CTX_X].tolist()  # one conversion instead of a NumPy scalar per field
+    mi = int(c[_CX_MODE])
+    info = int(c[_CX_INFO]) if code in _WITH_INFO else -1
+    status = "interrupted" if code == _YIELD else outcome(k, code, info)
+    return Run(code=code, status=status, t=c[_CX_T], mode=mi, x=ctx[CTX_X : CTX_X + k.meta["nx"][mi]].copy(),
+               steps=int(c[_CX_STEPS]), events=int(c[_CX_EVENTS]), info=info, ctx=ctx,
+               recorded=buf.result_and_release())
 
 
 #: Sample rows and event rows the buffers of a recording run start with: a walk of a few hundred

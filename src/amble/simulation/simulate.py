@@ -12,7 +12,6 @@ import numbers
 import operator
 import string
 from collections.abc import Mapping, Sequence
-from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,28 +29,61 @@ if TYPE_CHECKING:
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
                      ) -> np.ndarray:
     """Defaults overridden by ``params``; unknown names, non-finite values and (given the
-    ``system``) values outside a parameter's declared domain are :class:`ParameterError`."""
+    ``system``) values outside a parameter's declared domain are :class:`ParameterError`.
+    A new array on every call (callers keep it: a trajectory's ``params``)."""
+    key = _parameter_key(k, params)
+    hit = _PARAMETERS.get(key) if key is not None else None
+    if hit is not None and hit[0] is k:
+        if system is not None and hit[2]:
+            system.check_parameters(hit[2])  # domains are the system's: checked on every call
+        return hit[1].copy()
     names = k.meta["params"]
     p = np.array(k.meta["param_defaults"], dtype=float)
     if params is not None and not isinstance(params, Mapping):  # a list of pairs or of names reads ambiguously
         raise ParameterError(f"params must be a mapping of parameter names to values (e.g. {{'slope': 0.05}}), "
                              f"got a {type(params).__name__}")
+    given: dict[str, float] = {}
     if params:
-        for key, val in params.items():
-            if key not in names:
-                raise ParameterError(f"unknown parameter {key!r}; known: {', '.join(names)}")
+        for key_, val in params.items():
+            if key_ not in names:
+                raise ParameterError(f"unknown parameter {key_!r}; known: {', '.join(names)}")
             try:
                 v = float(val)
             except (TypeError, ValueError):
-                raise ParameterError(f"parameter {key!r} must be a number, got {val!r}") from None
+                raise ParameterError(f"parameter {key_!r} must be a number, got {val!r}") from None
             if not math.isfinite(v):
-                raise ParameterError(f"parameter {key!r} must be finite, got {val!r}")
-            p[names.index(key)] = v
+                raise ParameterError(f"parameter {key_!r} must be finite, got {val!r}")
+            p[names.index(key_)] = v
+        given = {key_: float(p[names.index(key_)]) for key_ in params}
         if system is not None:
-            system.check_parameters({key: float(p[names.index(key)]) for key in params})
+            system.check_parameters(given)
     if p.size == 0:
         p = np.zeros(1)
+    if key is not None:
+        if len(_PARAMETERS) >= 256:  # bounded: a sweep passes a new value on every call
+            _PARAMETERS.clear()
+        _PARAMETERS[key] = (k, p, given)
+        return p.copy()
     return p
+
+
+#: Parameter vectors by (id of the kernels, the overrides as given) → (kernels, vector, the
+#: overrides as checked against the domains): names, numbers and finiteness are checked once.
+_PARAMETERS: dict[tuple, tuple[Kernels, np.ndarray, dict[str, float]]] = {}
+
+
+def _parameter_key(k: Kernels, params: Any) -> tuple | None:
+    """The memo key of these overrides, or ``None`` (not memoised) unless every value is a plain
+    ``float`` or ``int``: two values that compare equal then convert to the same number."""
+    if not params:
+        return (id(k),) if params is None or type(params) is dict else None
+    if type(params) is not dict:
+        return None
+    items = tuple(params.items())
+    for _, v in items:
+        if type(v) is not float and type(v) is not int:
+            return None
+    return (id(k), *items)
 
 
 def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, mode: str | None
@@ -75,8 +107,9 @@ def initial_state(system: HybridSystem, k: Kernels, x0: Sequence[float] | None, 
         raise StateError(
             f"initial state has {x.size} values, mode {mode!r} needs {len(names)}: {', '.join(names)}"
         )
-    if not np.isfinite(x).all():
-        raise StateError(f"initial state is not finite: {x.tolist()}")
+    values = x.tolist()
+    if not all(map(math.isfinite, values)):  # a tenth of np.isfinite(x).all() on a short state
+        raise StateError(f"initial state is not finite: {values}")
     return mi, x
 
 
@@ -123,7 +156,7 @@ def simulate(
         ``"dop853"`` (explicit, the default) or ``"radau"`` (implicit Radau IIA with the model's
         exact Jacobian, for stiff systems); default that of ``options``.
     """
-    base = options or Options()
+    base = options or _DEFAULT_OPTIONS
     if not isinstance(base, Options):
         raise StateError(f"options must be an amble Options, got {type(base).__name__}")
     # the type of every argument is checked before any work: a string or a list compared with a
@@ -161,18 +194,18 @@ def simulate(
         raise
     traj = _trajectory(k, p, r, opts)
     if not samples:  # rows: where the run started and where it ended
-        x_end = np.full(k.nx_max, np.nan)
-        x_end[: r.x.size] = r.x
-        x_start = np.full(k.nx_max, np.nan)
-        x_start[: x.size] = x
-        traj.t, traj.mode = np.array([0.0, r.t]), np.array([mi, r.mode], dtype=np.int32)
-        traj.x = np.vstack([x_start, x_end])
+        rows = np.empty((2, k.nx_max))
+        rows.fill(np.nan)
+        rows[0, : x.size], rows[1, : r.x.size] = x, r.x
+        traj.t, traj.mode, traj.x = np.array([0.0, r.t]), np.array([mi, r.mode], dtype=np.int32), rows
     traj.system = system
     return traj
 
 
 def _real(value: Any, what: str) -> float:
     """``value`` as a float if it is a real number (not a bool, not text), else :class:`StateError`."""
+    if type(value) is float:  # the usual case, without the abstract-class check
+        return value
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise StateError(f"{what} must be a number, got {value!r}")
     return float(value)
@@ -183,6 +216,8 @@ def _count(value: Any, what: str, most: int) -> int | None:
     bool, not a float or text), else :class:`StateError`; ``None`` stays ``None``."""
     if value is None:
         return None
+    if type(value) is int and 1 <= value <= (most or 2**62):  # the usual case
+        return value
     try:
         n = operator.index(value) if not isinstance(value, bool) else None
     except TypeError:
@@ -195,27 +230,60 @@ def _count(value: Any, what: str, most: int) -> int | None:
     return n
 
 
-@lru_cache(maxsize=64)
+#: The options of a call that gives none.
+_DEFAULT_OPTIONS = Options()
+
+#: Options by (id(base), rtol, atol, max_step_time, method) → (base, options): the identity of
+#: ``base`` is checked on every hit (an id is reused once its object is gone).
+_OPTIONS: dict[tuple, tuple[Options, Options]] = {}
+
+
 def _options(base: Options, rtol: float, atol: float, max_step_time: float, method: str) -> Options:
     """``base`` with these tolerances, step-time limit and integrator; one object per distinct
-    setting, so its laid-out option arrays (cached on it) are built once, not on every call."""
-    return dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=max_step_time, method=method)
+    setting, so its laid-out option arrays (cached on it) are built once, not on every call.
+    Keyed by the identity of ``base`` (hashing a frozen dataclass of eleven fields took longer
+    than the rest of the lookup); a new ``Options`` per call still gets equal results."""
+    key = (id(base), rtol, atol, max_step_time, method)
+    hit = _OPTIONS.get(key)
+    if hit is not None and hit[0] is base:
+        return hit[1]
+    if len(_OPTIONS) >= 64:  # bounded: callers that make an Options per call would fill it
+        _OPTIONS.clear()
+    opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=max_step_time, method=method)
+    _OPTIONS[key] = (base, opts)
+    return opts
 
 
 def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
     meta = k.meta
     trs = meta["transitions"]
     rec = r.recorded
-    # per transition once: its names and the state lengths on either side; the Event objects are
-    # made when first read (about half a microsecond per footfall, often never needed)
-    modes, nx = meta["modes"], meta["nx"]
-    kinds = [(tr["name"], tr["source"], tr["target"], nx[modes.index(tr["source"])], nx[modes.index(tr["target"])])
-             for tr in trs]
-    events: Sequence[Event] = (Events(rec["et"], rec["etr"], rec["epre"], rec["epost"], kinds, k.nx_max)
+    # the Event objects are made when first read (about half a microsecond per footfall, often
+    # never needed)
+    events: Sequence[Event] = (Events(rec["et"], rec["etr"], rec["epre"], rec["epost"], _kinds(meta), k.nx_max)
                                if len(rec.get("et", ())) else [])
     return Trajectory(t=rec["t"], mode=rec["mode"], x=rec["x"], events=events, status=r.status,
                       message=_message(r, opts, trs, meta.get("switches", [])), steps=r.steps, params=p,
                       kernels=k, final_state=r.x, final_mode=meta["modes"][r.mode])
+
+
+#: Per transition list (by identity, checked on every hit): its names and the state lengths on
+#: either side, as :class:`Events` reads them.
+_KINDS: dict[int, tuple[list, list]] = {}
+
+
+def _kinds(meta: dict) -> list[tuple[str, str, str, int, int]]:
+    trs = meta["transitions"]
+    hit = _KINDS.get(id(trs))
+    if hit is not None and hit[0] is trs:
+        return hit[1]
+    modes, nx = meta["modes"], meta["nx"]
+    kinds = [(tr["name"], tr["source"], tr["target"], nx[modes.index(tr["source"])], nx[modes.index(tr["target"])])
+             for tr in trs]
+    if len(_KINDS) >= 64:
+        _KINDS.clear()
+    _KINDS[id(trs)] = (trs, kinds)
+    return kinds
 
 
 #: How each way of ending reads, by status name (:data:`amble.backend.abi.STATUS`).
@@ -245,21 +313,25 @@ _NAMES = {c: n for n, c in CODE.items()}
 _FIELDS = {name: {f for _, f, _, _ in string.Formatter().parse(text) if f} for name, text in _MESSAGES.items()}
 
 
+#: How each message field is worked out from (run, options, transitions, switching surfaces).
+_FIELD_VALUES = {
+    "t": lambda r, o, trs, sw: r.t, "steps": lambda r, o, trs, sw: r.steps, "events": lambda r, o, trs, sw: r.events,
+    "x": lambda r, o, trs, sw: r.x.tolist(), "max_step_time": lambda r, o, trs, sw: o.max_step_time,
+    "zeno_events": lambda r, o, trs, sw: o.zeno_events, "zeno_dt": lambda r, o, trs, sw: o.zeno_dt,
+    "max_steps_between_events": lambda r, o, trs, sw: o.max_steps_between_events,
+    "max_integrator_steps": lambda r, o, trs, sw: o.max_integrator_steps, "surface": lambda r, o, trs, sw: r.info,
+    "surface_expr": lambda r, o, trs, sw: _surface(r, sw),
+    "transition": lambda r, o, trs, sw: trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "",
+    "stiff": lambda r, o, trs, sw: _stiff_hint(r, o),
+}
+
+
 def _message(r: Run, opts: Options, trs: list, switches: list) -> str:
     name = _NAMES.get(r.code, "")
     template = _MESSAGES.get(name, "stopped at t = {t:.6g} s")
     # only the fields this template reads are worked out (the state as a list, the stiffness
     # hint: microseconds on every call of simulate() otherwise)
-    fields = {
-        "t": lambda: r.t, "steps": lambda: r.steps, "events": lambda: r.events, "x": lambda: r.x.tolist(),
-        "max_step_time": lambda: opts.max_step_time, "zeno_events": lambda: opts.zeno_events,
-        "zeno_dt": lambda: opts.zeno_dt, "max_steps_between_events": lambda: opts.max_steps_between_events,
-        "max_integrator_steps": lambda: opts.max_integrator_steps, "surface": lambda: r.info,
-        "surface_expr": lambda: _surface(r, switches),
-        "transition": lambda: trs[r.info]["name"] if r.info >= 0 and r.code != CODE["SLIDING"] else "",
-        "stiff": lambda: _stiff_hint(r, opts),
-    }
-    return template.format(**{f: fields[f]() for f in _FIELDS.get(name, ("t",))})
+    return template.format(**{f: _FIELD_VALUES[f](r, opts, trs, switches) for f in _FIELDS.get(name, ("t",))})
 
 
 def _stiff_hint(r: Run, opts: Options) -> str:

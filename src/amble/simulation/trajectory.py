@@ -63,6 +63,18 @@ class Events(Sequence):
     def __len__(self) -> int:
         return len(self._t) if self._items is None else len(self._items)
 
+    def last_post(self, transitions: frozenset[int]) -> np.ndarray | None:
+        """A copy of the post-event state of the last event of one of these ``transitions`` (by
+        index), or ``None``: read from the event rows, without making the Event objects (the
+        command line's summary of a long walk read them all for its last footfall)."""
+        tr, kinds = self._tr, self._kinds
+        for i in range(len(tr) - 1, -1, -1):  # a walk usually ends at a footfall: one row read
+            j = int(tr[i])
+            if j in transitions:
+                nt = kinds[j][4]
+                return self._post[i, :nt].copy()
+        return None
+
     def __getitem__(self, i: Any) -> Any:
         return self._list()[i]
 
@@ -119,6 +131,9 @@ class Trajectory:
     @property
     def final_post_impact_state(self) -> np.ndarray | None:
         """State just after the last footfall (the Poincaré section of a walker), if any."""
+        if isinstance(self.events, Events):
+            steps = frozenset(i for i, tr in enumerate(self.kernels.meta["transitions"]) if tr["step"])
+            return self.events.last_post(steps)
         ev = self.step_events
         return ev[-1].x_post.copy() if ev else None
 
