@@ -28,6 +28,7 @@ import hashlib
 import json
 import os
 import re
+from functools import lru_cache
 from pathlib import Path
 from typing import NamedTuple
 
@@ -77,14 +78,22 @@ class Toolchain(NamedTuple):
 
 def runtime_key(cap: int, tc: Toolchain) -> str:
     """Cache key of the runtime object of capacity ``cap`` built with ``tc``."""
+    h = hashlib.sha256(_sources_digest().encode())
+    h.update(tc.identity.encode())
+    h.update(f"\0{CAPACITY_MACRO}={cap}".encode())
+    return h.hexdigest()[:24]
+
+
+@lru_cache(maxsize=1)
+def _sources_digest() -> str:
+    """Hash of the engine's C sources and the Python↔C header, once per process (as the model
+    libraries' own :func:`amble.backend.cache.source_digest`)."""
     h = hashlib.sha256(b"amble-runtime\0")
     for f in sorted(C_DIR.iterdir()):
         if f.suffix in (".c", ".h"):
             h.update(f.name.encode() + b"\0" + f.read_bytes())
     h.update(abi.c_header().encode())
-    h.update(tc.identity.encode())
-    h.update(f"\0{CAPACITY_MACRO}={cap}".encode())
-    return h.hexdigest()[:24]
+    return h.hexdigest()
 
 
 def cached_object(d: Path, cap: int, tc: Toolchain) -> Path | None:
