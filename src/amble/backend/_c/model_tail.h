@@ -13,7 +13,8 @@
  * amble_nxcap_<AMBLE_NXCAP> it references exists only in a unit generated for that capacity, so a
  * model linked with the runtime of another capacity fails to link instead of misreading.
  *
- * Needs from the including unit: everything hybrid.c lists, and AMBLE_NXCAP.
+ * Needs from the including unit: the generated kernels and tables, the macros NMODES, NXMAX, NTR,
+ * NPOINTS, NPARAM, NSWMAX, NPFULL, the ST_* codes, and AMBLE_NXCAP.
  */
 #ifndef AMBLE_MODEL_TAIL_H
 #define AMBLE_MODEL_TAIL_H
