@@ -4,7 +4,9 @@ The chain: point mass ``m_i`` at the end of massless link ``i`` of length ``l_i`
 ``q_i`` measured from the downward vertical (positive counter-clockwise seen with x right, z up);
 gravity ``g`` along −z. Masses, lengths and ``g`` are run-time parameters on both sides.
 
-amble side, in a fresh interpreter with an empty ``AMBLE_CACHE_DIR`` (a cold cache):
+amble side, in a fresh interpreter with a fresh ``AMBLE_CACHE_DIR`` (a cold cache: no model
+compiled, the shared runtime seeded — :mod:`benchmarks.runtime_seed`; its one-time compile is a
+row of its own):
 ``amble`` and its code generator are imported first (not timed, as the peer imports SymPy before
 its clock starts); then the Model is written, wrapped in a :class:`amble.HybridSystem` with no
 transitions and built with :func:`amble.backend.kernels.build` — which runs :func:`amble.derive`, generates
@@ -37,13 +39,13 @@ from benchmarks.common import (
     Stats,
     child_env,
     emit_result,
-    fresh_cache_dir,
     ratio,
     run_worker,
     sci,
     sec,
     table,
 )
+from benchmarks.runtime_seed import SECTION_NOTE, row_text, seeded_cache_dir
 
 #: Chain sizes with a stated goal: n -> seconds (cold derive + codegen + compile).
 GOALS: dict[int, float] = {6: 1.0, 20: 10.0}
@@ -87,6 +89,7 @@ def worker(n: int, check: bool) -> dict[str, Any]:
     import amble.backend.cache as cache
     import amble.backend.codegen as codegen
     import amble.backend.kernels as kernels
+    import amble.backend.runtime as runtime
 
     spans: dict[str, float] = {"derive_s": 0.0, "generate_s": 0.0, "compile_s": 0.0}
     captured: list[Any] = []
@@ -123,6 +126,7 @@ def worker(n: int, check: bool) -> dict[str, Any]:
         "build_s": t2 - t1,
         "total_s": t2 - t0,
         "count_ops": eq.count_ops(),
+        "runtime_compiles": runtime.COMPILES,  # 0: the seeded runtime was used, as intended
     }
     if check:
         out.update(check_qdd(k, n))
@@ -157,8 +161,9 @@ def check_qdd(k: Any, n: int, seed: int = 0) -> dict[str, float]:
 
 
 def amble_once(n: int, check: bool = False, timeout_s: float = 180.0) -> dict[str, Any] | None:
-    """One cold build of the n-chain in a fresh process with a fresh, empty cache dir."""
-    cache = fresh_cache_dir()
+    """One cold build of the n-chain in a fresh process with a fresh cache dir (no model in it; the
+    shared runtime seeded: :mod:`benchmarks.runtime_seed`)."""
+    cache = seeded_cache_dir()
     try:
         args = [str(n)] + (["--check"] if check else [])
         return run_worker("benchmarks.bench_derive", ["--worker", *args], child_env(cache), timeout_s)
@@ -203,6 +208,8 @@ def run(quick: bool = False) -> Section:
             stop_note = f"amble n = {n} stopped after {LIMIT_S * 1.5:.0f} s."
             print(f"  {stop_note}", flush=True)
             break
+        if any(s.get("runtime_compiles") for s in samples):
+            raise RuntimeError("a cold build compiled the runtime: the seeded cache did not match its key")
         amble_stats[n] = Stats.of([s["total_s"] for s in samples])
         # report the breakdown of the median run
         amble_res[n] = sorted(samples, key=lambda s: s["total_s"])[len(samples) // 2]
@@ -238,6 +245,8 @@ def run(quick: bool = False) -> Section:
         total = sec(st.median) + (f" (min {sec(st.min)}, {st.n} runs)" if st.n > 1 else "")
         rows.append([str(n), total, sec(a["derive_s"]), sec(a["codegen_s"]), sec(a["compile_s"]),
                      str(a["count_ops"]), *p_cells])
+    caps = tuple(sorted({8, 16} if max(amble_res, default=2) <= 8 else {8, 16, 32, 64}))
+    rows.append(["runtime, once per machine", "", "", "", row_text(caps), "", "", "", "", "", ""])
     header = ["n", "amble total s", "derive", "codegen", "C compile", "amble ops (CSE)",
               "SymPy total s", "SymPy derive", "lambdify", "SymPy ops (CSE)", "SymPy / amble"]
     reps_note = (f"n = 6 and 20: median of {reps_goal} fresh processes (min in brackets); other n: one run. "
@@ -245,7 +254,7 @@ def run(quick: bool = False) -> Section:
     md = [
         "Cold derive + code generation + C compile of an n-link planar pendulum chain (point masses at "
         "the link ends, absolute angles, all masses/lengths/g as run-time parameters). Each amble run is "
-        "a fresh Python process with an empty `AMBLE_CACHE_DIR`; *total* = writing the Model + "
+        "a fresh Python process with a fresh `AMBLE_CACHE_DIR`. " + SECTION_NOTE + " *total* = writing the Model + "
         "`amble.backend.kernels.build` (derive, codegen, `cc -O2` compile, load), imports excluded on both sides. "
         + reps_note
         + "SymPy peer: `LagrangesMethod` + `lambdify(cse=True)` in a fresh process per n, one run each, "

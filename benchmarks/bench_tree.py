@@ -3,12 +3,14 @@
 Cases: a spatial chain of n rigid bodies (full inertia tensors, joint axes cycling y, x, z,
 written with ``Model.rigid_tree()``) for n = 2 … 30, and the URDF robots of ``tests/data``
 (12-DOF biped, 30-DOF humanoid) loaded with ``Model.from_urdf``. Each build runs in a fresh
-interpreter with an empty ``AMBLE_CACHE_DIR``: *build* = model + derive + generate + compile + load
-(wall clock; imports excluded — the URDF parser's own import, which pulls in trimesh and
-scipy.spatial, is done before the clock starts and reported separately). The stages are timed
-inside the same run: *derive* (``derive`` as called by the code generator), *generate* (the rest
-of code generation: common subexpressions, printing) and *cc* (the C compiler, wall). ``ops``:
-:meth:`amble.Equations.count_ops` (M, h with shared subexpressions); the growth exponent is the
+interpreter with a fresh ``AMBLE_CACHE_DIR`` (no model compiled; the shared runtime seeded, its
+one-time compile reported in a row of its own: :mod:`benchmarks.runtime_seed`): *build* = model +
+derive + generate + compile + load (wall clock; imports excluded — the URDF parser's own import,
+which pulls in trimesh and scipy.spatial, is done before the clock starts and reported
+separately). The stages are timed inside the same run: *derive* (``derive`` as called by the code
+generator), *generate* (the rest of code generation: common subexpressions, printing) and *cc*
+(the C compiler, wall). ``ops``: :meth:`amble.Equations.count_ops` (M, h with shared
+subexpressions); the growth exponent is the
 least-squares slope of log ops against log n over the chain sizes n ≥ 4.
 
 Per call: amble's q̈ (``amble_rhs``: M, h, Cholesky solve) timed **in C**, by a loop compiled
@@ -34,7 +36,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchmarks.common import Goal, Section, child_env, emit_result, fresh_cache_dir, run_worker, table
+from benchmarks.common import Goal, Section, child_env, emit_result, run_worker, table
+from benchmarks.runtime_seed import SECTION_NOTE, row_text, seeded_cache_dir
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
 STATES = 64  # random states cycled through by the per-call loops
@@ -190,7 +193,7 @@ def _cold(case: str, runs: int) -> dict | None:
     the build times of all."""
     got, builds = None, []
     for _ in range(runs):
-        cache = fresh_cache_dir()
+        cache = seeded_cache_dir()
         try:
             r = run_worker("benchmarks.bench_tree", ["--worker", case], child_env(cache), timeout_s=1200)
         finally:
@@ -232,7 +235,9 @@ def run(quick: bool = False) -> Section:
                      f"{r['generate_s']:.2f}", f"{r['cc_s']:.2f}", r["ops"], f"{r['rhs_c_s']['median'] * 1e6:.2f} µs"])
     fit = [(r["n"], r["ops"]) for r in data.values() if r["n"] >= 4]
     slope = _slope([a for a, _ in fit], [b for _, b in fit]) if len(fit) >= 2 else None
-    md = ["Spatial chain (axes cycling y, x, z; full inertia tensors):", "",
+    rows.append(["runtime, once per machine", row_text((8, 16) if quick else (8, 16, 32, 64)),
+                 "", "", "", "", "", "", ""])
+    md = [SECTION_NOTE, "", "Spatial chain (axes cycling y, x, z; full inertia tensors):", "",
           table(["n", "cold build (wall)", "CPU (process + cc)", "model s", "derive s", "generate s", "cc s",
                  "ops (M, h)", "q̈ per call (C)"], rows)]
     if slope is not None:

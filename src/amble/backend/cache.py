@@ -29,6 +29,13 @@ The cache heals and cannot be steered:
   write to it; a cache that cannot be used (read-only, a file, no home) falls back to a private
   temporary one for the process, with one warning.
 
+Every library links the model-independent runtime (the event loop, the implicit integrator,
+sensitivities, batches: :mod:`amble.backend.runtime`), compiled once per capacity bucket and
+toolchain into ``runtime-<key>-<sha>.o`` beside the libraries, with ``runtime-<key>.json`` holding
+its SHA-256; it heals in the same way (a damaged object is rebuilt). A library's key covers the
+runtime's: the engine sources and the toolchain are in both, and the capacity follows from the
+structure.
+
 The cache lives in ``$AMBLE_CACHE_DIR``, else ``$XDG_CACHE_HOME/amble``, else
 ``~/.cache/amble``. ``$CC`` picks the C compiler (default ``cc``); a C99 compiler is the one
 system requirement of amble.
@@ -48,6 +55,8 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import CompileError
 from ..version import __version__
+from . import runtime
+from .runtime import C_DIR
 from .units import run_compilers, split_units
 
 # shutil, subprocess and tempfile are imported where a library is compiled: a warm start needs none
@@ -55,7 +64,6 @@ from .units import run_compilers, split_units
 if TYPE_CHECKING:  # the lookup of a warm cache imports no SymPy (see backend/index.py)
     from ..modelling.hybrid import HybridSystem
 
-C_DIR = Path(__file__).resolve().parent / "_c"  # a package on disk (importlib.resources costs ~10 ms)
 _PKG = Path(__file__).resolve().parents[1]
 
 #: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.
@@ -174,6 +182,11 @@ def toolchain() -> str:
     """Compiler command, its identity and the flags, as one string."""
     cc = compiler()
     return "\0".join([cc, compiler_identity(cc), *cflags()])
+
+
+def runtime_toolchain() -> runtime.Toolchain:
+    """The toolchain the shared runtime is compiled with: that of the model libraries."""
+    return runtime.Toolchain(compiler(), cflags(), toolchain())
 
 
 def _structure_digest(system: HybridSystem) -> str:
@@ -317,12 +330,17 @@ def _remove_orphans(d: Path) -> None:
 def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
     """Compile ``src`` into ``d/<key>-<sha>.so``; returns the path and the library's SHA-256.
 
-    A source with a function of its own unit (:func:`split_units`) is compiled as two units at
-    once and linked: the largest kernel of a big tree model takes as long as the integrator and
-    everything else together, so on two cores the wall time nearly halves."""
+    A generated model unit (it names the capacity of its runtime, :func:`runtime.capacity_of`) is
+    linked with the shared runtime object (:mod:`amble.backend.runtime`, compiled once per
+    capacity and toolchain); any other source is compiled on its own. A source with a function of
+    its own unit (:func:`split_units`) is compiled as two units at once and linked: the largest
+    kernel of a big tree model takes as long as everything else together, so on two cores the
+    wall time nearly halves."""
     import tempfile
 
     cc = compiler()
+    cap = runtime.capacity_of(src)
+    linked = [] if cap is None else [str(runtime.runtime_object(d, cap, runtime_toolchain()))]
     with tempfile.TemporaryDirectory(prefix="build-", dir=d) as tmpd:
         out = Path(tmpd) / "model.so"
         base = [*cc.split(), *cflags(), "-std=c99", "-Werror=implicit-function-declaration", "-fPIC"]
@@ -333,11 +351,11 @@ def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
             files.append(Path(tmpd) / f"model{i or ''}.c")
             files[-1].write_text(text)
         if own is None:
-            run_compilers([[*base, "-shared", "-I", str(C_DIR), str(files[0]), "-o", str(out), "-lm"]], cc)
+            run_compilers([[*base, "-shared", "-I", str(C_DIR), str(files[0]), *linked, "-o", str(out), "-lm"]], cc)
         else:
             objs = [f.with_suffix(".o") for f in files]
             run_compilers([[*base, "-c", "-I", str(C_DIR), str(f), "-o", str(o)] for f, o in zip(files, objs)], cc)
-            run_compilers([[*base, "-shared", *map(str, objs), "-o", str(out), "-lm"]], cc)
+            run_compilers([[*base, "-shared", *map(str, objs), *linked, "-o", str(out), "-lm"]], cc)
         if not out.is_file() or out.stat().st_size == 0:
             raise CompileError(f"C compiler {cc!r} reported success but wrote no library")
         digest = _sha256(out)

@@ -5,9 +5,10 @@ coordinates read from the state array ``x`` (``x[i]`` = qᵢ, ``x[n+i]`` = q̇�
 from ``p`` — parameters are run-time inputs, so changing a mass or a slope recompiles nothing.
 Nothing symbolic is derived here: the equations of motion come from
 :mod:`amble.derivation.equations`, impact and lock maps from :mod:`amble.derivation.impact`, and
-the interface codes from :func:`amble.backend.abi.c_header`. The generated unit includes
-``hybrid.c``, the integrator and event loop, so the whole walking step is compiled together and
-the right-hand side is inlined into the integrator.
+the interface codes from :func:`amble.backend.abi.c_header`. The generated unit ends with
+``model_tail.h``: the model's sizes and kernels as hidden symbols for the shared runtime (the
+event loop, compiled once: :mod:`amble.backend.runtime`) and the DOP853 step, compiled here so
+that the right-hand side is inlined into the integrator.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from .codegen_support import bool_expr as _bool_block
 from .codegen_support import symbol_names as _names
 from .hoist import Hoister
 from .ldl import UNROLL_MAX, constant_pivots, ldl_order, ldl_solve_code
+from .runtime import CAPACITY_MACRO, TAIL, capacity
 from .trig import pythagoras
 from .units import UNIT_BEGIN, UNIT_END
 from .variational_codegen import derivative_kernels, derivative_stubs
@@ -123,23 +125,26 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
     w('#include "amble_core.h"\n')
     w(abi.c_header())
     w(f"#define NMODES {len(modes)}\n#define NXMAX {max(nx)}\n#define NTR {ntr}\n")
+    # the state capacity of the shared runtime this unit is linked with (backend/runtime.py)
+    w(f"#define {CAPACITY_MACRO} {capacity(max(nx))}\n")
     if len(set(nx)) == 1:  # one state length: the integrator's loops get constant trip counts
         w(f"#define NX_FIXED {nx[0]}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
     w("#define SC (NXMAX + NPARAM)\n")  # columns of a sensitivity row: state, then parameters
-    w(f"static const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
-    w(f"static const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")
-    w(f"static const int MODE_TR0[NMODES] = {{{', '.join(map(str, tr0))}}};\n")
+    w(f"AMBLE_HIDDEN const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
+    w(f"AMBLE_HIDDEN const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")
+    w(f"AMBLE_HIDDEN const int MODE_TR0[NMODES] = {{{', '.join(map(str, tr0))}}};\n")
     w(f"#define NSWMAX {max(len(v) for v in switches.values())}\n")
-    w(f"static const int MODE_NSW[NMODES] = {{{', '.join(str(len(switches[m])) for m in modes)}}};\n")
-    w(f"static const int MODE_SW0[NMODES] = {{{', '.join(map(str, sw0))}}};\n")
+    w(f"AMBLE_HIDDEN const int MODE_NSW[NMODES] = {{{', '.join(str(len(switches[m])) for m in modes)}}};\n")
+    w(f"AMBLE_HIDDEN const int MODE_SW0[NMODES] = {{{', '.join(map(str, sw0))}}};\n")
     arr = lambda vals: ", ".join(map(str, vals)) if vals else "0"
-    w(f"static const int TR_DIR[NTR > 0 ? NTR : 1] = {{{arr([tr.guard.direction for tr in order])}}};\n")
-    w(f"static const int TR_TERMINAL[NTR > 0 ? NTR : 1] = {{{arr([int(tr.terminal is not None) for tr in order])}}};\n")
-    w(f"static const int TR_STEP[NTR > 0 ? NTR : 1] = {{{arr([int(tr.step) for tr in order])}}};\n")
+    w(f"AMBLE_HIDDEN const int TR_DIR[NTR > 0 ? NTR : 1] = {{{arr([tr.guard.direction for tr in order])}}};\n")
+    terminal = [int(tr.terminal is not None) for tr in order]
+    w(f"AMBLE_HIDDEN const int TR_TERMINAL[NTR > 0 ? NTR : 1] = {{{arr(terminal)}}};\n")
+    w(f"AMBLE_HIDDEN const int TR_STEP[NTR > 0 ? NTR : 1] = {{{arr([int(tr.step) for tr in order])}}};\n")
     # the transition taken instead of a zeno end when this one's firings accumulate (-1: none)
     index = {tr.name: j for j, tr in enumerate(order)}
-    w(f"static const int TR_REST[NTR > 0 ? NTR : 1] = {{{arr([index.get(tr.rest, -1) for tr in order])}}};\n\n")
+    w(f"AMBLE_HIDDEN const int TR_REST[NTR > 0 ? NTR : 1] = {{{arr([index.get(tr.rest, -1) for tr in order])}}};\n\n")
 
     for name, mi in modes.items():
         m, eq, k = mi.model, mi.equations, mi.index
@@ -258,7 +263,7 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
              "reset_{}(t, x, p, xout, target)", [tr.name for tr in order], "tr")
     pnames = {s: f"p[{params.index(str(s))}]" for s in hoist.params}
     w(hoist.c_code(len(params), pnames, _block))
-    w('\n#include "hybrid.c"\n')
+    w(f'\n#include "{TAIL}"\n')
 
     meta = {
         "name": system.name,

@@ -90,12 +90,13 @@ class Kernels:
         except OSError as e:
             raise CompileError(f"cannot load compiled model {so}: {e}") from None
         self._lib = lib
-        info = np.zeros(8, dtype=np.int64)
+        info = np.zeros(9, dtype=np.int64)
         lib.amble_info.argtypes = [_i64ptr]
         lib.amble_info(info.ctypes.data_as(_i64ptr))
         self.n_modes, self.nx_max, self.n_tr, self.n_points = (int(v) for v in info[:4])
         self.layout = int(info[6])
         self.sc = int(info[7])  # columns of a sensitivity row (state, then parameters)
+        self.nx_capacity = int(info[8])  # the state capacity of the shared runtime it links (backend/runtime.py)
         if self.layout != abi.LAYOUT:
             raise CompileError(
                 f"compiled model {so} has interface layout {self.layout}, this amble expects {abi.LAYOUT}: "

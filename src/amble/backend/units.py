@@ -33,9 +33,10 @@ def split_units(src: str) -> tuple[str, str | None]:
     return "".join(main) + rest, defines + "".join(own)
 
 
-def run_compilers(cmds: list[list[str]], cc: str) -> None:
+def run_compilers(cmds: list[list[str]], cc: str, what: str = "the generated model") -> None:
     """Run the compiler commands side by side (a machine's cores compile the units in parallel);
-    a failure of any is a :class:`CompileError` with the compiler's first error lines."""
+    a failure of any is a :class:`CompileError` with the compiler's first error lines (``what``:
+    the code compiled, for the message)."""
     import subprocess  # here, not at import: a warm start compiles nothing
 
     try:
@@ -58,4 +59,4 @@ def run_compilers(cmds: list[list[str]], cc: str) -> None:
             lines = [ln.strip() for ln in err.splitlines() if ln.strip()]
             errors = [ln for ln in lines if "error" in ln.lower()] or lines
             said = "; ".join(errors[:3])[:500] if errors else "no output"
-            raise CompileError(f"C compilation of the generated model failed ({cc!r}, exit {pr.returncode}): {said}")
+            raise CompileError(f"C compilation of {what} failed ({cc!r}, exit {pr.returncode}): {said}")

@@ -1,14 +1,15 @@
 /* Hybrid simulation loop: integrate a mode, find the step's event, record, reset or end — all
  * in compiled code, one call per simulation. The pieces live in their own headers:
- *   dop853.h  the integrator (steps, dense output, Hermite interpolant)
+ *   dop853.h  the integrator's state (its step is compiled in the model's unit: dop853_step.h)
  *   radau.h   the implicit integrator for stiff runs (IO_METHOD = 1), same dense-output contract
  *   events.h  guard screening and crossing location inside a step
  *   record.h  sample and event rows in caller-owned buffers
  *   rest.h    a contact coming to rest instead of a zeno end (TR_REST)
  *
- * This file is included at the end of a generated translation unit, which defines:
- *   the interface codes ST_*, CX_*, OP_*, IO_* and AMBLE_LAYOUT (from amble/backend/abi.py)
- *   NMODES, NXMAX, NTR, NPOINTS, NPARAM
+ * This file is the body of the runtime (runtime.c), compiled once and linked into every model's
+ * library; what it knows of the model (model.h) is defined by the model's unit:
+ *   the interface codes ST_*, CX_*, OP_*, IO_* and AMBLE_LAYOUT (amble_abi.h, from abi.py)
+ *   NMODES, NXMAX, NTR, NPOINTS, NPARAM (run-time constants)
  *   MODE_NX[NMODES], MODE_NTR[NMODES], MODE_TR0[NMODES]
  *   TR_DIR[NTR] (-1 falling, +1 rising, 0 both), TR_TERMINAL[NTR] (1 = ends the run),
  *   TR_STEP[NTR] (1 = counts as a walking step), TR_REST[NTR] (rest transition instead of zeno, or -1)
@@ -61,6 +62,10 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     s.radau = 0;
     const int implicit = iopt[IO_METHOD] == 1;
     Radau rad;
+    /* the implicit integrator's matrices, for this model's size; none for an explicit run */
+    double rad_w[implicit ? radau_doubles() : 1];
+    int rad_iw[implicit ? radau_ints() : 1];
+    radau_attach(&rad, rad_w, rad_iw);
     radau_reset(&rad);
     int mode = (int)ctx[CX_MODE];
     if (mode < 0 || mode >= NMODES) return ST_RESET_FAILED;
@@ -327,6 +332,7 @@ void amble_info(int64_t *out) {
     out[5] = CX_X;
     out[6] = AMBLE_LAYOUT;
     out[7] = SC;
+    out[8] = AMBLE_CAT(amble_nxcap_, AMBLE_NXCAP); /* the integrator's capacity (model_tail.h) */
 }
 
 /* ---- many walks per call (basin maps, sweeps) ---- */

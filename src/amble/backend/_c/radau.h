@@ -35,13 +35,25 @@ static double rad_mu_re(void) { return 3.0 + 0.5 * (cbrt(3.0) - cbrt(9.0)); }
 static double rad_mu_im(void) { return -0.5 * (pow(3.0, 5.0 / 6.0) + pow(3.0, 7.0 / 6.0)); }
 
 typedef struct {
-    double J[NXMAX * SC];                          /* ∂f/∂x at the last Jacobian point (rows of SC) */
-    double LUr[NXMAX * NXMAX], LUc[4 * NXMAX * NXMAX];
-    int pr[NXMAX], pc[2 * NXMAX];
+    double *J;                                     /* ∂f/∂x at the last Jacobian point (NXMAX rows of SC) */
+    double *LUr, *LUc;                             /* NXMAX², 4 NXMAX² */
+    int *pr, *pc;                                  /* NXMAX, 2 NXMAX */
     int have_jac, current_jac, have_lu, have_sol;
     double lu_h;                                   /* the step size the LU factors are for */
     double h_abs_old, err_old;                     /* for the predictive step-size controller */
 } Radau;
+
+/* The workspace of radau_attach, sized for the model (the caller's variable-length arrays). */
+static int radau_doubles(void) { return NXMAX * SC + 5 * NXMAX * NXMAX; }
+static int radau_ints(void) { return 3 * NXMAX; }
+
+static void radau_attach(Radau *r, double *w, int *iw) {
+    r->J = w;
+    r->LUr = w + NXMAX * SC;
+    r->LUc = r->LUr + NXMAX * NXMAX;
+    r->pr = iw;
+    r->pc = iw + NXMAX;
+}
 
 /* Forget everything tied to the current trajectory (after an event or a mode change). */
 static void radau_reset(Radau *r) { r->have_jac = r->have_lu = r->have_sol = 0; r->h_abs_old = 0.0; r->err_old = 0.0; }

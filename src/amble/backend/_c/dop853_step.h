@@ -1,0 +1,206 @@
+/* DOP853 (Hairer, Norsett & Wanner) as implemented in SciPy: same tableau, error norm, step-size
+ * control and 7th-order dense output, so results can be compared step for step. Also the cheap
+ * cubic Hermite interpolant through both step ends used to screen guards.
+ *
+ * The step itself is compiled in the model's own translation unit (this file is included by
+ * model_tail.h), with the right-hand side inlined into it: the stage sums and the right-hand side
+ * are nearly all of a small model's integrator time. The functions are hidden, not static: the
+ * runtime (runtime.c, compiled once) calls them directly inside the model's library.
+ *
+ * Needs from the including unit: the ST_* codes (generated from abi.py), NXMAX and
+ *   int rhs(int mode, double t, const double *x, const double *p, double *dx);
+ */
+#ifndef AMBLE_DOP853_STEP_H
+#define AMBLE_DOP853_STEP_H
+#include "dop853.h"
+
+/* The state length of the step. A unit whose modes all have one length defines NX_FIXED to it, so
+ * every loop over the state has a constant trip count and is unrolled by the compiler (measured:
+ * the stage sums are a third of the compass gait's integrator time with a run-time length). */
+#ifdef NX_FIXED
+#define DOP_N(s) NX_FIXED
+#else
+#define DOP_N(s) ((s)->n)
+#endif
+
+static double rms_norm(int n, const double *v) {
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += v[i] * v[i];
+    return sqrt(s / n);
+}
+
+/* Initial step size as in Hairer's / SciPy's select_initial_step. */
+AMBLE_HIDDEN double initial_step(int mode, double t, const double *y, const double *f, const double *p,
+                           double t_bound, double max_step, double rtol, double atol, int n) {
+    double sc[NXMAX], tmp[NXMAX], y1[NXMAX], f1[NXMAX];
+    double interval = fabs(t_bound - t);
+    if (interval == 0.0) return 0.0;
+    for (int i = 0; i < n; ++i) sc[i] = atol + fabs(y[i]) * rtol;
+    for (int i = 0; i < n; ++i) tmp[i] = y[i] / sc[i];
+    double d0 = rms_norm(n, tmp);
+    for (int i = 0; i < n; ++i) tmp[i] = f[i] / sc[i];
+    double d1 = rms_norm(n, tmp);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (h0 > interval) h0 = interval;
+    for (int i = 0; i < n; ++i) y1[i] = y[i] + h0 * f[i];
+    if (rhs(mode, t + h0, y1, p, f1)) return 1e-6;
+    for (int i = 0; i < n; ++i) tmp[i] = (f1[i] - f[i]) / sc[i];
+    double d2 = rms_norm(n, tmp) / h0;
+    double h1;
+    if (d1 <= 1e-15 && d2 <= 1e-15) h1 = fmax(1e-6, h0 * 1e-3);
+    else h1 = pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
+    double h = fmin(100 * h0, h1);
+    h = fmin(h, interval);
+    return fmin(h, max_step);
+}
+
+/* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status. */
+AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, double rtol, double atol,
+                    double max_step, double *h_abs) {
+    const int n = DOP_N(s);
+    const double t = s->t_old;
+    double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
+    double ha = *h_abs;
+    if (ha > max_step) ha = max_step;
+    if (ha < min_step) ha = min_step;
+    int rejected = 0, saw_nan = 0;
+    double ytmp[NXMAX];
+    for (;;) {
+        if (ha < min_step) return saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
+        double t_new = t + ha;
+        if (t_new > t_bound) t_new = t_bound;
+        double h = t_new - t;
+        ha = fabs(h);
+        for (int i = 0; i < n; ++i) s->K[0][i] = s->f_old[i];
+        int err = 0;
+        /* Stage sums run over the stages outermost (an independent accumulator per component) and
+         * skip the tableau's zeros; per component the additions are those of the plain sum, in
+         * its order, so the results are bitwise the same. */
+        double acc[NXMAX], a3[NXMAX];
+        for (int st = 1; st < DOP_STAGES && !err; ++st) {
+            const double *a = DOP_A + st * DOP_STAGES_EXT;
+            for (int i = 0; i < n; ++i) acc[i] = 0.0;
+            for (int j = 0; j < st; ++j) {
+                const double c = a[j];
+                if (c == 0.0) continue;
+                for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
+            }
+            for (int i = 0; i < n; ++i) ytmp[i] = s->y_old[i] + h * acc[i];
+            err = rhs(mode, t + DOP_C[st] * h, ytmp, p, s->K[st]);
+        }
+        if (err) return ST_SINGULAR_MASS;
+        for (int i = 0; i < n; ++i) acc[i] = 0.0;
+        for (int j = 0; j < DOP_STAGES; ++j) {
+            const double c = DOP_B[j];
+            if (c == 0.0) continue;
+            for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
+        }
+        for (int i = 0; i < n; ++i) s->y[i] = s->y_old[i] + h * acc[i];
+        if (rhs(mode, t + h, s->y, p, s->K[DOP_STAGES])) return ST_SINGULAR_MASS;
+        for (int i = 0; i < n; ++i) acc[i] = a3[i] = 0.0; /* acc: the 5th-order error, a3: the 3rd */
+        for (int j = 0; j <= DOP_STAGES; ++j) {
+            const double c5 = DOP_E5[j], c3 = DOP_E3[j];
+            if (c5 == 0.0 && c3 == 0.0) continue;
+            for (int i = 0; i < n; ++i) {
+                acc[i] += c5 * s->K[j][i];
+                a3[i] += c3 * s->K[j][i];
+            }
+        }
+        double e5 = 0.0, e3 = 0.0;
+        for (int i = 0; i < n; ++i) {
+            const double ya = fabs(s->y_old[i]), yb = fabs(s->y[i]);
+            const double sc = atol + (ya > yb ? ya : yb) * rtol; /* fmax is a library call at -O2 */
+            const double b5 = acc[i] / sc, b3 = a3[i] / sc;
+            e5 += b5 * b5;
+            e3 += b3 * b3;
+        }
+        double error_norm;
+        if (e5 == 0.0 && e3 == 0.0) error_norm = 0.0;
+        else error_norm = ha * e5 / sqrt((e5 + 0.01 * e3) * n);
+        if (!isfinite(error_norm) || !all_finite(n, s->y)) {
+            saw_nan = 1;
+            ha *= 0.2;
+            rejected = 1;
+            continue;
+        }
+        if (error_norm < 1.0) {
+            double factor = error_norm == 0.0 ? 10.0 : fmin(10.0, 0.9 * pow(error_norm, -1.0 / 8.0));
+            if (rejected && factor > 1.0) factor = 1.0;
+            *h_abs = ha * factor;
+            s->h = h;
+            for (int i = 0; i < n; ++i) s->f[i] = s->K[DOP_STAGES][i];
+            s->dense_ready = 0;
+            return 0;
+        }
+        ha *= fmax(0.2, 0.9 * pow(error_norm, -1.0 / 8.0));
+        rejected = 1;
+    }
+}
+
+/* 7th-order continuous extension of the last step (three extra stages). The sums run over the
+ * stages outermost, so each state component is an independent accumulator (no chain of
+ * dependent multiply-adds per component), and skip the tableau's zeros; the order of the
+ * additions per component is that of the plain sum, so the result is bitwise the same. */
+AMBLE_HIDDEN int dop_dense_prepare(Dop *s, int mode, const double *p) {
+    if (s->dense_ready || s->radau) return 0;
+    const int n = DOP_N(s);
+    const double h = s->h;
+    double acc[NXMAX];
+    for (int st = DOP_STAGES + 1; st < DOP_STAGES_EXT; ++st) {
+        const double *a = DOP_A + st * DOP_STAGES_EXT;
+        for (int i = 0; i < n; ++i) acc[i] = 0.0;
+        for (int j = 0; j < st; ++j) {
+            const double c = a[j];
+            if (c == 0.0) continue;
+            for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
+        }
+        for (int i = 0; i < n; ++i) acc[i] = s->y_old[i] + h * acc[i];
+        if (rhs(mode, s->t_old + DOP_C[st] * h, acc, p, s->K[st])) return ST_SINGULAR_MASS;
+    }
+    for (int i = 0; i < n; ++i) {
+        double dy = s->y[i] - s->y_old[i];
+        s->F[0][i] = dy;
+        s->F[1][i] = h * s->f_old[i] - dy;
+        s->F[2][i] = 2.0 * dy - h * (s->f[i] + s->f_old[i]);
+    }
+    for (int r = 0; r < 4; ++r) {
+        const double *d = DOP_D + r * DOP_STAGES_EXT;
+        for (int i = 0; i < n; ++i) acc[i] = 0.0;
+        for (int j = 0; j < DOP_STAGES_EXT; ++j) {
+            const double c = d[j];
+            if (c == 0.0) continue;
+            for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
+        }
+        for (int i = 0; i < n; ++i) s->F[3 + r][i] = h * acc[i];
+    }
+    s->dense_ready = 1;
+    return 0;
+}
+
+/* The dense output at t: Horner in x and 1 - x, all components side by side. */
+AMBLE_HIDDEN void dop_dense_eval(const Dop *s, double t, double *out) {
+    const int n = DOP_N(s);
+    const double x = (t - s->t_old) / s->h, y1 = 1.0 - x;
+    if (s->radau) {
+        for (int i = 0; i < n; ++i) out[i] = s->y_old[i] + x * (s->Q[0][i] + x * (s->Q[1][i] + x * s->Q[2][i]));
+        return;
+    }
+    double y[NXMAX];
+    for (int i = 0; i < n; ++i) y[i] = 0.0;
+    for (int k = DOP_INTERP - 1, c = 0; k >= 0; --k, ++c) {
+        const double m = (c % 2 == 0) ? x : y1;
+        for (int i = 0; i < n; ++i) y[i] = (y[i] + s->F[k][i]) * m;
+    }
+    for (int i = 0; i < n; ++i) out[i] = y[i] + s->y_old[i];
+}
+
+/* Cubic Hermite through both step ends: cheap, for spotting sign changes inside a step. */
+AMBLE_HIDDEN void hermite_eval(const Dop *s, double theta, double *out) {
+    const double h = s->h;
+    double t2 = theta * theta, t3 = t2 * theta;
+    double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + theta, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+    for (int i = 0; i < DOP_N(s); ++i)
+        out[i] = h00 * s->y_old[i] + h10 * h * s->f_old[i] + h01 * s->y[i] + h11 * h * s->f[i];
+}
+
+#endif
