@@ -155,3 +155,22 @@ def test_a_result_file_in_use_by_another_sweep_is_refused(tmp_path):
             ResultStore(out, ["i", "v"], ["i"])
     with ResultStore(out, ["i", "v"], ["i"]) as again:  # released at the end of the first
         assert again.has(("0",))
+
+
+def test_basin_threads_reach_the_api_and_do_not_change_the_cells(tmp_path):
+    grid = ["--x", "stance=-0.35:-0.15:3", "--x", "stance_dot=0.9:1.3:3", "--steps", "10"]
+    files = []
+    for threads in ("1", "2"):
+        out = tmp_path / f"b{threads}.csv"
+        rc = main(["sweep", "compass-gait", "--kind", "basin", *grid, "--scheduler", "synchronous",
+                   "--threads", threads, "--out", str(out), "--json"])
+        assert rc == 0
+        files.append(out.read_text())
+    assert files[0] == files[1] and files[0].count("\n") >= 9
+
+
+@pytest.mark.parametrize("extra", [["--kind", "basin", "--x", "stance=-0.3:-0.2:2", "--x", "stance_dot=1:1.2:2",
+                                    "--threads", "0"],
+                                   ["--param", "slope=0.04:0.05:2", "--threads", "2"]])
+def test_bad_threads_exit_2_with_one_line(capsys, extra):
+    _one_line_error(capsys, ["sweep", "compass-gait", *extra, "--scheduler", "synchronous"], "UsageError")

@@ -262,6 +262,7 @@ def _key(structure: str, env_cc: str, env_flags: str, env_path: str) -> str:
     return h.hexdigest()[:24]
 
 
+@lru_cache(maxsize=256)  # a pure function of its argument, asked on every build(): hashed once
 def derivatives_key(key: str) -> str:
     """Cache key of the library that also holds the derivative kernels (a superset of ``key``'s)."""
     return hashlib.sha256(f"{key}:derivatives".encode()).hexdigest()[:24]

@@ -307,6 +307,10 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                          "address of an existing Dask scheduler, e.g. tcp://host:8786 (default: local "
                          "worker processes)")
     sw.add_argument("--workers", type=int, default=None, help="local Dask worker processes (default: cores)")
+    sw.add_argument("--threads", type=int, default=None,
+                    help="--kind basin: threads per process — with --scheduler synchronous, tasks run side by "
+                         "side on this many threads of this process; on Dask, each task's walks share them "
+                         "(default 1)")
     sw.set_defaults(func=cmd_sweep)
 
     def model_arg(sp: argparse.ArgumentParser) -> None:

@@ -44,6 +44,10 @@ def sweep_cli(args: Any) -> dict[str, Any]:
             Options(**{nm: v})  # the tolerances' domain, checked once before any work
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be at least 1, got {args.workers}")
+    threads = getattr(args, "threads", None)
+    if threads is not None and (threads < 1 or not basin_kind):
+        raise UsageError(f"--threads must be at least 1, got {threads}" if threads < 1
+                         else "--threads applies to --kind basin only")
     out = writable_path(args.out, (".csv", ".parquet"), "--out")
     plot = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     # the compiled model when the index holds it: no SymPy here, nor in workers it is sent to
@@ -176,7 +180,7 @@ def _run_basin(system: Any, ranges: list[tuple[str, float, float, int]], args: A
     """Basin of attraction over the two ``--x`` coordinates; fills ``summary``, returns the result."""
     steps = BASIN_STEPS if args.steps is None else args.steps
     res = basin(system, (ranges[0][0], ranges[1][0]), ((ranges[0][1], ranges[0][2]), (ranges[1][1], ranges[1][2])),
-                (ranges[0][3], ranges[1][3]), steps=steps, **common)
+                (ranges[0][3], ranges[1][3]), steps=steps, threads=getattr(args, "threads", None) or 1, **common)
     counts = res.counts()
     cells = res.outcome.size
     done = int(np.sum(res.outcome >= 0))
