@@ -43,6 +43,27 @@ def test_rewrite_keeps_values_and_hoists_maximal_parts():
     assert Hoister({m, l, g, k}, enabled=False)(exprs) == exprs
 
 
+def test_a_graph_without_parameters_comes_back_as_it_was():
+    # an unevaluated shared graph (a tree's positions) is not rebuilt: rebuilding evaluates,
+    # which re-flattens the graph and asks sympy for signs of all of it
+    m, l = sp.symbols("m l", positive=True)
+    q, v = sp.symbols("q v", real=True)
+    e = q
+    for _ in range(30):
+        half_cos = sp.Mul(sp.Float(0.5), sp.cos(e, evaluate=False), evaluate=False)
+        e = sp.Add(half_cos, sp.Mul(-1, 2, e, evaluate=False), evaluate=False)
+    h = Hoister({m, l})
+    assert h.one(e) is e and not h.values
+    # a relation is rebuilt unevaluated: sympy would decide (q + m·l)² + 1 > 0 to True
+    rel = sp.StrictGreaterThan(sp.Pow(q + m * l, 2) + 1, 0, evaluate=False)
+    out = h.one(rel)
+    assert isinstance(out, sp.StrictGreaterThan) and len(h.values) == 1
+    assert h.values[0][1] == m * l
+    back = {s: x for s, x in h.values}
+    subs = {m: 1.3, l: 0.7, q: -0.4}
+    assert math.isclose(float(out.lhs.xreplace(back).xreplace(subs)), float(rel.lhs.xreplace(subs)), rel_tol=1e-15)
+
+
 def _pendulum():
     """A point mass on a massless rod with viscous damping; a terminal guard th = a·cos(b)
     (rising): parameter-only products and a parameter's cosine for the prelude."""

@@ -9,7 +9,7 @@ import subprocess
 import sympy as sp
 
 from amble.backend.cache import compiler
-from amble.backend.codegen_support import Printer, shared_cse
+from amble.backend.codegen_support import SHARED_MIN_NODES, Printer, is_shared_graph, shared_cse
 from amble.modelling.dag import fold, free_symbols
 
 x, y, z = sp.symbols("x y z", real=True)
@@ -84,3 +84,30 @@ def test_shared_cse_rebuilds_the_expressions():
         for old, new in zip(exprs, reduced):
             want = _value(old, at)
             assert abs(_value(new, at) - want) <= 1e-12 * (1 + abs(want))
+
+
+def _deep_graph(n: int) -> sp.Expr:
+    """A chain whose every node uses its predecessor twice (as a tree: 2ⁿ nodes), with powers
+    and functions of sums, as a tree's kinematics builds them (unevaluated)."""
+    e = x
+    for k in range(n):
+        square = sp.Pow(sp.Add(e, y, evaluate=False), 2, evaluate=False)
+        e = sp.Add(sp.Mul(sp.cos(e, evaluate=False), square, evaluate=False),
+                   sp.Mul(sp.Rational(1, k + 2), e, evaluate=False), evaluate=False)
+    return e
+
+
+def test_a_shared_graph_is_recognised_and_kept_shared():
+    deep = _deep_graph(SHARED_MIN_NODES // 5 + 1)
+    assert is_shared_graph([deep])  # a tree of ~2^200 nodes: sympy's cse would not finish
+    assert not is_shared_graph(_graph(random.Random(2), 40))  # small: sympy's cse searches it
+    assert not is_shared_graph([sp.Add(*[sp.sin(k * x) for k in range(1, 2 * SHARED_MIN_NODES)])])  # large, no sharing
+    repl, reduced = shared_cse([deep])
+    assert len(repl) <= 4 * (SHARED_MIN_NODES // 5 + 1)  # linear in the graph
+    at = {x: 0.3, y: -0.2}
+    for s, e in repl:  # the rebuilt powers and functions keep their values (built unevaluated)
+        at[s] = _value(e, at)
+    want = 0.3
+    for k in range(SHARED_MIN_NODES // 5 + 1):  # the same recursion in floating point
+        want = math.cos(want) * (want - 0.2) ** 2 + want / (k + 2)
+    assert abs(_value(reduced[0], at) - want) <= 1e-12 * (1 + abs(want))

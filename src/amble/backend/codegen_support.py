@@ -166,10 +166,12 @@ def block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str],
     ``shared``: the expressions are graphs whose common parts are already shared (a rigid-body
     tree's kinematics and energies, expanded from its named intermediate quantities): each
     subexpression used more than once becomes a temporary as it stands (:func:`shared_cse`),
-    instead of ``sympy.cse`` searching again for what the recursion built once."""
+    instead of ``sympy.cse`` searching again for what the recursion built once. Expressions that
+    are such graphs (:func:`is_shared_graph`: a tree's guards and relabelling) are treated so
+    without being told."""
     if not exprs:
         return ""
-    if shared:
+    if shared or is_shared_graph(exprs):
         repl, reduced = shared_cse(exprs)
     else:
         repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("c_"), order="none")
@@ -178,6 +180,36 @@ def block(targets: list[str], exprs: list[sp.Expr], names: dict[sp.Symbol, str],
     lines += [f"{indent}const double {pr.doprint(s)} = {pr.doprint(e)};" for s, e in repl]
     lines += [f"{indent}{tgt} = {pr.doprint(e)};" for tgt, e in zip(targets, reduced)]
     return "\n".join(lines) + "\n"
+
+
+#: Distinct compound subexpressions from which :func:`is_shared_graph` looks at the sharing.
+SHARED_MIN_NODES = 1000
+
+
+def is_shared_graph(exprs: list[Any]) -> bool:
+    """Whether ``exprs`` are large graphs whose common parts are shared already: at least
+    :data:`SHARED_MIN_NODES` distinct compound subexpressions, written out as trees more than
+    four times as many. A rigid-body tree's positions, expanded from its recursion, are such
+    graphs (the 12-DOF biped's footfall guard: 30× as large as a tree); ``sympy.cse`` walks and
+    rebuilds them as trees, evaluated, and takes minutes for what the graph shares already.
+    Linear in the number of distinct subexpressions."""
+    size: dict[int, int] = {}
+    stack = [sp.sympify(e) for e in exprs]
+    while stack:  # post-order by identity: the tree size of each node, each node once
+        e = stack[-1]
+        if id(e) in size or e.is_Atom:
+            stack.pop()
+            continue
+        todo = [a for a in e.args if not a.is_Atom and id(a) not in size]
+        if todo:
+            stack.extend(todo)
+            continue
+        size[id(e)] = 1 + sum(size.get(id(a), 1) for a in e.args)
+        stack.pop()
+    if len(size) < SHARED_MIN_NODES:
+        return False
+    total = sum(size.get(id(e), 1) for e in map(sp.sympify, exprs))
+    return total > 4 * len(size)
 
 
 def shared_cse(exprs: list[sp.Expr]) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
@@ -205,8 +237,10 @@ def shared_cse(exprs: list[sp.Expr]) -> tuple[list[tuple[sp.Symbol, sp.Expr]], l
             return e
         if all(a is b for a, b in zip(args, e.args)):
             r = e
-        elif isinstance(e, (sp.Add, sp.Mul)):
-            r = e.func(*args, evaluate=False)  # as built: no re-flattening of shared parts
+        elif isinstance(e, (sp.Add, sp.Mul, sp.Pow, sp.Function)):
+            # as built: no re-flattening of shared parts, and no questions to sympy about the
+            # signs of a graph (an evaluated power of a sum asks them: seconds per power)
+            r = e.func(*args, evaluate=False)
         else:
             r = e.func(*args)
         if uses.get(e, 0) > 1:

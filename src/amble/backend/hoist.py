@@ -27,6 +27,7 @@ from __future__ import annotations
 from typing import Any
 
 import sympy as sp
+from sympy.core.relational import Relational
 
 from ..modelling.dag import fold
 
@@ -55,6 +56,7 @@ class Hoister:
         self._memo: dict = {}
         self._expr: dict[sp.Symbol, sp.Expr] = {}  # hoisted symbol → its expression
         self._flag: dict[Any, bool] = {}  # rewritten nodes: parameter-only or not
+        self._kept: set[int] = set()  # ids of mixed nodes that came back as they were
 
     def _take(self, e: sp.Expr) -> sp.Expr:
         """The hoisted symbol of ``e`` (a new slot unless an equal expression has one). A negated
@@ -83,27 +85,50 @@ class Hoister:
         ``a + b`` hoisted (sympy expands, so mass matrices are full of ``m₁·u + m₂·u + …``)."""
         groups: dict[Any, list[Any]] = {}
         const: list[Any] = []
+        alone: dict[Any, Any] = {}  # the term as it came, for a part no other term shares
+        out_plain: list[Any] = []  # terms without a parameter: left as they are
         for r, c in kids:
             if c:
                 const.append(r)
                 continue
             fs = sp.Mul.make_args(r)
             cf = [f for f in fs if self._const(f)]
+            if all(f.is_Number for f in cf):  # nothing to hoist: numbers are folded by sympy (or C)
+                out_plain.append(r)
+                continue
             vf = [f for f in fs if not self._const(f)]
-            groups.setdefault(sp.Mul(*vf), []).append(sp.Mul(*cf))
+            var = sp.Mul(*vf)
+            groups.setdefault(var, []).append(sp.Mul(*cf))
+            alone[var] = r
         out = []
         for var, coeffs in groups.items():
             if len(coeffs) == 1:
-                out.append(coeffs[0] * var)
+                out.append(alone[var])  # not rebuilt: a shared graph stays shared
                 continue
             total = sp.Add(*coeffs).xreplace(self._expr)  # in parameters only: the prelude has no order
             out.append((self._take(total) if _hoistable(total) else total) * var)
-        if len(const) >= 2:
+        if all(a.is_Number for a in const):
+            pass
+        elif len(const) >= 2:
             part = sp.Add(*const)
             const = [self._take(part) if _hoistable(part) else part]
         else:
             const = [self._take(a) if _hoistable(a) else a for a in const]
-        return const + out
+        return const + out + out_plain
+
+    def _same(self, new: list[Any], kids: list[tuple[Any, bool]], e: sp.Basic) -> bool:
+        """Whether ``new`` holds ``e``'s arguments as they were (in any order): each the very
+        argument, or the rewritten form of one that came back unchanged (the fold's memo hands
+        back the first of equal subexpressions it met, so "unchanged" is an equal object)."""
+        if len(new) != len(e.args):
+            return False
+        stand = {id(r): a for (r, _), a in zip(kids, e.args)
+                 if r is a or id(r) in self._kept or (a.is_Atom and r == a)}
+        return {id(stand.get(id(x), x)) for x in new} == {id(a) for a in e.args}
+
+    def _keep(self, e: sp.Basic) -> sp.Basic:
+        self._kept.add(id(e))
+        return e
 
     def _combine(self, e: Any, kids: list[tuple[Any, bool]]) -> tuple[Any, bool]:
         """(rewritten node, whether it is parameter-only). A parameter-only node is left whole for
@@ -114,21 +139,33 @@ class Hoister:
             return e, bool(getattr(e, "is_number", False))
         if all(c for _, c in kids):
             return e, isinstance(e, sp.Expr)
+        # A node whose arguments come back as they were is kept, not rebuilt: rebuilding
+        # evaluates, and an evaluated sum, power, function or relation of a rigid-body tree's
+        # shared graph re-flattens it and asks sympy for signs and assumptions of the whole
+        # graph (``ahead > margin`` of the 12-DOF walker's footfall: 98 s of its build)
         if isinstance(e, sp.Add):
-            r = sp.Add(*self._collect(kids))
+            terms = self._collect(kids)
+            r = self._keep(e) if self._same(terms, kids, e) else sp.Add(*terms)
         elif isinstance(e, sp.Mul):
             const = [a for a, c in kids if c]
             rest = [a for a, c in kids if not c]
-            if len(const) >= 2:  # the parameter-only part of a flattened product, as one value
+            if all(a.is_Number for a in const):  # numbers only: nothing to hoist
+                pass
+            elif len(const) >= 2:  # the parameter-only part of a flattened product, as one value
                 part = e.func(*const)
                 const = [self._take(part) if _hoistable(part) else part]
             else:
                 const = [self._take(a) if _hoistable(a) else a for a in const]
-            r = e.func(*const, *rest)
+            r = self._keep(e) if self._same([*const, *rest], kids, e) else e.func(*const, *rest)
         else:
             args = [self._take(a) if c and _hoistable(a) else a for a, c in kids]
-            same = all(a is b for a, b in zip(args, e.args))
-            r = e if same else e.func(*args)
+            if self._same(args, kids, e):
+                r = self._keep(e)
+            elif isinstance(e, (Relational, sp.Pow, sp.Function)):
+                # only a hoisted value replaced a part: nothing for sympy to evaluate
+                r = e.func(*args, evaluate=False)
+            else:
+                r = e.func(*args)
         self._flag[r] = False
         return r, False
 
