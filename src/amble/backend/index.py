@@ -31,7 +31,6 @@ lookup off.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import warnings
@@ -43,6 +42,7 @@ from ..errors import AmbleError
 from ..version import __version__
 from . import cache
 from .compiled import FORMAT, CompiledSystem, describe
+from .digest import sha256
 
 if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
@@ -58,7 +58,7 @@ def enabled() -> bool:
 def index_key(spec: str, sources: Sequence[Path]) -> str:
     """Hash of a model's spec, its source files and amble's generating sources (see the module
     docstring); :class:`OSError` if a source cannot be read."""
-    h = hashlib.sha256(f"amble-index\0{FORMAT}\0{__version__}\0{spec}\0".encode())
+    h = sha256(f"amble-index\0{FORMAT}\0{__version__}\0{spec}\0".encode())
     h.update(cache.source_digest().encode())
     h.update(_ROOT_INIT.read_bytes())
     h.update(f"\0{os.environ.get('CC', '')}\0{os.environ.get('AMBLE_CFLAGS', '-O2')}\0".encode())
@@ -98,7 +98,7 @@ def lookup(spec: str, sources: Sequence[Path], loader: Callable[[], HybridSystem
         return None
     for f, digest in files.items():  # what the model read while it was built must be unchanged
         try:
-            if hashlib.sha256(Path(f).read_bytes()).hexdigest() != digest:
+            if sha256(Path(f).read_bytes()).hexdigest() != digest:
                 return None
         except OSError:
             return None
@@ -131,7 +131,7 @@ def record(spec: str, sources: Sequence[Path], system: HybridSystem, files: Sequ
         path = entry_path(spec, sources, d)
         entry: dict[str, Any] = {
             "format": FORMAT, "spec": spec, "library": cache.structure_key(system),
-            "files": {str(f): hashlib.sha256(Path(f).read_bytes()).hexdigest() for f in files},
+            "files": {str(f): sha256(Path(f).read_bytes()).hexdigest() for f in files},
             "system": describe(system),
         }
         data = json.dumps(entry).encode()
