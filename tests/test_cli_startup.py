@@ -84,3 +84,53 @@ def test_the_help_is_argparses_own_at_any_width(monkeypatch, columns):
     ours = helps(_HelpFormatter)
     assert ours == helps(argparse.RawDescriptionHelpFormatter)
     assert "--period" in "".join(ours)
+
+
+def test_a_stamp_serves_the_digest_until_a_file_changes(tmp_path, monkeypatch):
+    from amble.backend import stamps
+
+    monkeypatch.setattr(stamps, "RACY_NS", 0)  # files written just now count as settled
+    files = [tmp_path / "a.py", tmp_path / "b.c"]
+    files[0].write_text("x = 1\n")
+    files[1].write_text("int f;\n")
+    calls = []
+
+    def truth() -> str:  # the digest of the contents, computed afresh
+        calls.append(1)
+        return hashlib.sha256(b"".join(f.read_bytes() for f in files)).hexdigest()
+
+    first = stamps.stamped_digest(tmp_path, "id", files, truth)
+    assert first == truth() and len(calls) == 2
+    assert stamps.stamped_digest(tmp_path, "id", files, truth) == first and len(calls) == 2  # from the stamp
+    st = os.stat(files[0])
+    files[0].write_text("x = 2\n")  # same size, and the old mtime put back: only ctime tells
+    os.utime(files[0], ns=(st.st_atime_ns, st.st_mtime_ns))
+    if os.stat(files[0]).st_ctime_ns == st.st_ctime_ns:
+        pytest.skip("this file system's ctime did not move within the test")
+    changed = stamps.stamped_digest(tmp_path, "id", files, truth)
+    assert changed != first and changed == truth()
+    assert stamps.stamped_digest(tmp_path, "other id", files, truth) == changed and len(calls) == 5
+
+
+def test_a_file_changed_just_now_is_never_stamped(tmp_path):
+    from amble.backend import stamps
+
+    f = tmp_path / "fresh.py"
+    f.write_text("y = 1\n")
+    calls = []
+    for _ in range(2):
+        assert stamps.stamped_digest(tmp_path, "id", [f], lambda: calls.append(1) or "d") == "d"
+    assert len(calls) == 2 and not list(tmp_path.glob("stamp-*.json"))
+
+
+def test_the_warm_index_key_is_the_hash_of_the_sources(tmp_path, monkeypatch):
+    from amble.backend import index
+    from amble.models import source_files
+
+    sources = source_files("compass-gait")
+    path = index.entry_path("compass-gait", sources, tmp_path)
+    assert path == tmp_path / f"index-{index.index_key('compass-gait', sources)}.json"
+    assert index.entry_path("compass-gait", sources, tmp_path) == path  # again (from the stamp, if settled)
+    monkeypatch.setenv("AMBLE_CFLAGS", "-O1")
+    assert index.entry_path("compass-gait", sources, tmp_path) == tmp_path / (
+        f"index-{index.index_key('compass-gait', sources)}.json") != path

@@ -43,6 +43,7 @@ from ..version import __version__
 from . import cache
 from .compiled import FORMAT, CompiledSystem, describe
 from .digest import sha256
+from .stamps import stamped_digest
 
 if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
@@ -69,8 +70,14 @@ def index_key(spec: str, sources: Sequence[Path]) -> str:
 
 
 def entry_path(spec: str, sources: Sequence[Path], d: Path | None = None) -> Path:
-    """Where the index entry of a model lives."""
-    return (d or cache.cache_dir()) / f"index-{index_key(spec, sources)}.json"
+    """Where the index entry of a model lives. The key's hash of the sources is reused from a
+    stamp while their file status is unchanged (:mod:`amble.backend.stamps`)."""
+    d = d or cache.cache_dir()
+    files = [*cache.source_files(), _ROOT_INIT, *map(Path, sources)]
+    env = os.environ
+    ident = "\0".join(["amble-index", str(FORMAT), __version__, spec, env.get("CC", ""),
+                       env.get("AMBLE_CFLAGS", "-O2"), *map(str, files)])
+    return d / f"index-{stamped_digest(d, ident, files, lambda: index_key(spec, sources))}.json"
 
 
 def lookup(spec: str, sources: Sequence[Path], loader: Callable[[], HybridSystem],
