@@ -10,7 +10,7 @@ of misread.
 
 from __future__ import annotations
 
-import hashlib
+from .digest import sha256
 
 #: Run status codes: (code, C name, outcome name). Outcome ``None``: not an end of the run (the
 #: loop returns to have its buffers grown); ``"terminal"`` is refined to the terminal
@@ -115,7 +115,7 @@ def _layout_text() -> str:
 
 
 #: A 60-bit fingerprint of the whole layout; the compiled library reports the one it was built with.
-LAYOUT = int(hashlib.sha256(_layout_text().encode()).hexdigest()[:15], 16)
+LAYOUT = int(sha256(_layout_text().encode()).hexdigest()[:15], 16)
 
 
 def c_header(layout: int | None = None) -> str:

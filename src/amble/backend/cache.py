@@ -43,7 +43,6 @@ system requirement of amble.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import time
@@ -55,16 +54,20 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import CompileError
 from ..version import __version__
-from . import runtime
-from .runtime import C_DIR
+from .digest import sha256
 from .units import run_compilers, split_units
 
-# shutil, subprocess and tempfile are imported where a library is compiled: a warm start needs none
+# shutil, subprocess, tempfile and the runtime's builder (.runtime) are imported where a library is
+# compiled: a warm start needs none of them
 
 if TYPE_CHECKING:  # the lookup of a warm cache imports no SymPy (see backend/index.py)
     from ..modelling.hybrid import HybridSystem
+    from . import runtime
 
 _PKG = Path(__file__).resolve().parents[1]
+#: The C engine's sources (:data:`amble.backend.runtime.C_DIR`, named here so that a warm start
+#: does not import the runtime's builder).
+C_DIR = _PKG / "backend" / "_c"
 
 #: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.
 _SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/*.py")
@@ -137,7 +140,7 @@ def source_files() -> list[Path]:
 @lru_cache(maxsize=1)
 def source_digest() -> str:
     """Hash of the amble version and of every file of :func:`source_files` (once per process)."""
-    h = hashlib.sha256(__version__.encode())
+    h = sha256(__version__.encode())
     for f in source_files():
         h.update(f.name.encode())
         h.update(f.read_bytes())
@@ -186,6 +189,8 @@ def toolchain() -> str:
 
 def runtime_toolchain() -> runtime.Toolchain:
     """The toolchain the shared runtime is compiled with: that of the model libraries."""
+    from . import runtime
+
     return runtime.Toolchain(compiler(), cflags(), toolchain())
 
 
@@ -193,7 +198,7 @@ def _structure_digest(system: HybridSystem) -> str:
     """Hash of the system's structure (not parameter values or defaults)."""
     from ..modelling.dag import dag_srepr  # SymPy: only when a key is computed from a system
 
-    h = hashlib.sha256()
+    h = sha256()
     for name, m in system.modes.items():
         parts: list[Any] = [name, m.dims, m.q, list(m.params), sorted(m.points.items()), sorted(m.masses.items())]
         parts += [m._k_terms, m._v_terms, m._k_override, m._v_override, m._l_override]
@@ -256,7 +261,7 @@ def structure_key(system: HybridSystem) -> str:
 
 @lru_cache(maxsize=256)
 def _key(structure: str, env_cc: str, env_flags: str, env_path: str) -> str:
-    h = hashlib.sha256(structure.encode())
+    h = sha256(structure.encode())
     h.update(source_digest().encode())
     h.update(toolchain().encode())
     return h.hexdigest()[:24]
@@ -265,7 +270,7 @@ def _key(structure: str, env_cc: str, env_flags: str, env_path: str) -> str:
 @lru_cache(maxsize=256)  # a pure function of its argument, asked on every build(): hashed once
 def derivatives_key(key: str) -> str:
     """Cache key of the library that also holds the derivative kernels (a superset of ``key``'s)."""
-    return hashlib.sha256(f"{key}:derivatives".encode()).hexdigest()[:24]
+    return sha256(f"{key}:derivatives".encode()).hexdigest()[:24]
 
 
 def library(system: HybridSystem, key: str, derivatives: bool = False) -> tuple[Path, dict]:
@@ -306,7 +311,7 @@ def rebuild(system: HybridSystem, key: str, d: Path | None = None, derivatives: 
 
 
 def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    return sha256(path.read_bytes()).hexdigest()
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -338,6 +343,8 @@ def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
     kernel of a big tree model takes as long as everything else together, so on two cores the
     wall time nearly halves."""
     import tempfile
+
+    from . import runtime
 
     cc = compiler()
     cap = runtime.capacity_of(src)

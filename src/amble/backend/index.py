@@ -31,7 +31,6 @@ lookup off.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import warnings
@@ -43,6 +42,8 @@ from ..errors import AmbleError
 from ..version import __version__
 from . import cache
 from .compiled import FORMAT, CompiledSystem, describe
+from .digest import sha256
+from .stamps import stamped_digest
 
 if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
@@ -58,7 +59,7 @@ def enabled() -> bool:
 def index_key(spec: str, sources: Sequence[Path]) -> str:
     """Hash of a model's spec, its source files and amble's generating sources (see the module
     docstring); :class:`OSError` if a source cannot be read."""
-    h = hashlib.sha256(f"amble-index\0{FORMAT}\0{__version__}\0{spec}\0".encode())
+    h = sha256(f"amble-index\0{FORMAT}\0{__version__}\0{spec}\0".encode())
     h.update(cache.source_digest().encode())
     h.update(_ROOT_INIT.read_bytes())
     h.update(f"\0{os.environ.get('CC', '')}\0{os.environ.get('AMBLE_CFLAGS', '-O2')}\0".encode())
@@ -69,8 +70,14 @@ def index_key(spec: str, sources: Sequence[Path]) -> str:
 
 
 def entry_path(spec: str, sources: Sequence[Path], d: Path | None = None) -> Path:
-    """Where the index entry of a model lives."""
-    return (d or cache.cache_dir()) / f"index-{index_key(spec, sources)}.json"
+    """Where the index entry of a model lives. The key's hash of the sources is reused from a
+    stamp while their file status is unchanged (:mod:`amble.backend.stamps`)."""
+    d = d or cache.cache_dir()
+    files = [*cache.source_files(), _ROOT_INIT, *map(Path, sources)]
+    env = os.environ
+    ident = "\0".join(["amble-index", str(FORMAT), __version__, spec, env.get("CC", ""),
+                       env.get("AMBLE_CFLAGS", "-O2"), *map(str, files)])
+    return d / f"index-{stamped_digest(d, ident, files, lambda: index_key(spec, sources))}.json"
 
 
 def lookup(spec: str, sources: Sequence[Path], loader: Callable[[], HybridSystem],
@@ -98,7 +105,7 @@ def lookup(spec: str, sources: Sequence[Path], loader: Callable[[], HybridSystem
         return None
     for f, digest in files.items():  # what the model read while it was built must be unchanged
         try:
-            if hashlib.sha256(Path(f).read_bytes()).hexdigest() != digest:
+            if sha256(Path(f).read_bytes()).hexdigest() != digest:
                 return None
         except OSError:
             return None
@@ -131,7 +138,7 @@ def record(spec: str, sources: Sequence[Path], system: HybridSystem, files: Sequ
         path = entry_path(spec, sources, d)
         entry: dict[str, Any] = {
             "format": FORMAT, "spec": spec, "library": cache.structure_key(system),
-            "files": {str(f): hashlib.sha256(Path(f).read_bytes()).hexdigest() for f in files},
+            "files": {str(f): sha256(Path(f).read_bytes()).hexdigest() for f in files},
             "system": describe(system),
         }
         data = json.dumps(entry).encode()

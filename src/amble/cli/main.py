@@ -222,6 +222,30 @@ EXAMPLES = {
 }
 
 
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """argparse's raw-description formatter, measuring the terminal only when it lays out text.
+
+    argparse makes a formatter for every ``add_argument`` (to check the metavar) and each one asks
+    ``shutil.get_terminal_size()`` for the width at once: importing :mod:`shutil` (and with it
+    ``bz2``, ``lzma``, ``zlib``) costs a warm start ~2 ms for a width nobody reads. Here the widths
+    are those argparse's own formatter computes (same arguments), worked out on first use."""
+
+    def __init__(self, prog: str, indent_increment: int = 2, max_help_position: int = 24,
+                 width: int | None = None) -> None:
+        self._asked, self._sizes = (indent_increment, max_help_position, width), None
+        super().__init__(prog, indent_increment, max_help_position, width=80)  # 80: ignored (below)
+
+    def _measure(self) -> tuple[int, int]:
+        if self._sizes is None:
+            real = argparse.RawDescriptionHelpFormatter(self._prog, *self._asked)
+            self._sizes = (real._width, real._max_help_position)
+        return self._sizes
+
+    # argparse's __init__ assigns both; the assignments are dropped for the measured values
+    _width = property(lambda self: self._measure()[0], lambda self, value: None)
+    _max_help_position = property(lambda self: self._measure()[1], lambda self, value: None)
+
+
 class _Unused:
     """Stands in for the parser of a command that is not being run: every call is accepted and
     does nothing (building all seven parsers costs more than a warm limit cycle's search)."""
@@ -233,7 +257,7 @@ class _Unused:
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The command-line parser; ``only``: build that command's sub-parser alone (the one being run)."""
     p = _Parser(prog="amble", description="Equation-based modeling and simulation of walking robots.",
-                formatter_class=argparse.RawDescriptionHelpFormatter,
+                formatter_class=_HelpFormatter,
                 epilog="examples:\n  " + "\n  ".join(EXAMPLES.values()))
     p.add_argument("--version", action="version", version=f"amble {_version()}")
     sub = p.add_subparsers(dest="command", parser_class=_Parser, required=True)
@@ -242,7 +266,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         if only is not None and name != only:
             return _Unused()  # type: ignore[return-value]
         sp = sub.add_parser(name, help=help_, description=help_, epilog=f"example:\n  {EXAMPLES[name]}",
-                            formatter_class=argparse.RawDescriptionHelpFormatter)
+                            formatter_class=_HelpFormatter)
         sp.add_argument("--json", action="store_true", help="print a JSON object on stdout")
         return sp
 

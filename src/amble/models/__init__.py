@@ -26,10 +26,8 @@ from __future__ import annotations
 
 import contextlib
 import importlib
-import importlib.util
 import math
 import os
-import pkgutil
 import sys
 from functools import cache, lru_cache
 from pathlib import Path
@@ -45,6 +43,8 @@ if TYPE_CHECKING:  # the model library is listed and located without SymPy
 def registry() -> dict[str, str]:
     """Model name → module name, for every module of this package that defines ``NAME``, in the
     order the modules declare with ``POSITION`` (then by name)."""
+    import pkgutil  # here, not at import: a warm start by name needs no listing of the library
+
     found: list[tuple[float, str, str]] = []
     for info in pkgutil.iter_modules(__path__):
         mod = importlib.import_module(f"{__name__}.{info.name}")
@@ -186,6 +186,8 @@ def load_file(spec: str) -> HybridSystem:
     if not path.is_file():
         raise ModelError(f"model file {path_text!r} does not exist")
     mod_name = f"amble_user_model_{abs(hash(str(path.resolve())))}"
+    import importlib.util  # here, not at import: a library model is found without it
+
     loader_spec = importlib.util.spec_from_file_location(mod_name, path)
     module = importlib.util.module_from_spec(loader_spec)
     sys.modules[mod_name] = module  # dataclasses and pickling look modules up by name
