@@ -37,7 +37,11 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
 /* The 7th-order continuous extension of the last step (three extra stages); 0 or ST_SINGULAR_MASS. */
 AMBLE_HIDDEN int dop_dense_prepare(Dop *s, int mode, const double *p);
 /* The dense output of the last step at t. */
-AMBLE_HIDDEN void dop_dense_eval(const Dop *s, double t, double *out);
+AMBLE_HIDDEN void dop_dense_eval(const Dop *restrict s, double t, double *restrict out);
+/* Rows of the dense output at the grid times t0 + k·dt (k0 <= k < k1) after t: times into out_t,
+ * states into rows of out_x (NXMAX entries, NaN-padded); returns the number of rows. */
+AMBLE_HIDDEN int64_t dop_dense_rows(const Dop *restrict s, double t0, double dt, int64_t k0, int64_t k1, double t,
+                                    double *restrict out_t, double *restrict out_x);
 /* Cubic Hermite through both step ends at θ ∈ [0, 1]: cheap, for spotting sign changes. */
 AMBLE_HIDDEN void hermite_eval(const Dop *s, double theta, double *out);
 

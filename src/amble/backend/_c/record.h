@@ -19,7 +19,9 @@ static void put_row(Rec *r, double t, int mode, int n, const double *x) {
     r->out_t[k] = t;
     r->out_mode[k] = mode;
     double *row = r->out_x + k * NXMAX;
-    for (int i = 0; i < NXMAX; ++i) row[i] = i < n ? x[i] : NAN;
+    int i = 0;
+    for (; i < n; ++i) row[i] = x[i];
+    for (; i < NXMAX; ++i) row[i] = NAN;
 }
 
 static void put_event(Rec *r, double t, int tr, int n_pre, const double *x_pre, int n_post, const double *x_post) {
@@ -40,17 +42,16 @@ static int64_t grid_end(const double *ctx, double sample_dt, int64_t k0, double 
 }
 
 /* Rows of the output grid k0 .. k1-1 of the step from t, on its dense output (samples at or
- * before t were written by the previous step). Returns 0 or ST_SINGULAR_MASS. */
+ * before t were written by the previous step). The rows are written by the model's unit
+ * (dop_dense_rows), where the state length and the row stride are constants. Returns 0 or
+ * ST_SINGULAR_MASS. */
 static int put_grid_rows(Rec *r, Dop *s, int mode, const double *p, const double *ctx, double sample_dt,
                          int64_t k0, int64_t k1, double t) {
     if (dop_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
-    double xs[NXMAX];
-    for (int64_t k = k0; k < k1; ++k) {
-        double tk = ctx[CX_GRID_T0] + k * sample_dt;
-        if (tk <= t) continue;
-        dop_dense_eval(s, tk, xs);
-        put_row(r, tk, mode, s->n, xs);
-    }
+    const int64_t first = *r->n_out;
+    const int64_t m = dop_dense_rows(s, ctx[CX_GRID_T0], sample_dt, k0, k1, t, r->out_t + first, r->out_x + first * NXMAX);
+    for (int64_t k = first; k < first + m; ++k) r->out_mode[k] = mode;
+    *r->n_out = first + m;
     return 0;
 }
 
