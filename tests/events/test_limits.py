@@ -55,8 +55,9 @@ def test_ctrl_c_interrupts_the_compiled_loop():
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt) as info:
-            amble.simulate(sys_, [0.3, 0.0], t_end=1e9, options=Options(max_integrator_steps=0,
-                                                                        max_steps_between_events=0))
+            # a coarse grid: the 512 MiB recording budget must not end the run before the signal
+            amble.simulate(sys_, [0.3, 0.0], t_end=1e9, sample_dt=1.0,
+                           options=Options(max_integrator_steps=0, max_steps_between_events=0))
     finally:
         timer.cancel()
     assert time.monotonic() - t0 < 5.0
