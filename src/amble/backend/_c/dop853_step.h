@@ -54,17 +54,71 @@ AMBLE_HIDDEN double initial_step(int mode, double t, const double *y, const doub
     return fmin(h, max_step);
 }
 
-/* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status. */
+/* Aiming at a switching surface estimated at a fraction θ of a rejected trial: if θ > AIM_NEAR the
+ * retry ends AIM_SHORT (relative) short of it, a step with every stage on the near side; the
+ * surface then lies just ahead of the next step, which crosses it in a step barely longer than
+ * the gap, its overshoot cut for an error of AIM_ERR (the error there is about linear in it).
+ * Measured on the library's walkers with switches and a kinked pendulum (tests/events): crossing
+ * in one step aimed just past the surface takes fewer steps, but the crossing is located on the
+ * dense output of that step, whose stages beyond the surface spoil it — final states at 1e-10 up
+ * to 35× less accurate than SciPy's DOP853 switching branches exactly. */
+#define AIM_NEAR 0.05
+#define AIM_SHORT 0.02
+#define AIM_ERR 0.01
+
+/* Earliest crossing of a switching surface of `mode` inside a trial step of size h from the values
+ * sw0 and slopes swd0 (d/dt) at its start to the values at its end state y: the smallest root in
+ * (0, 1) of the quadratic in θ through g(0), h ġ(0) and g(1), of the first surface that changes
+ * sign. Returns it times h (s), or −1 if no surface changes sign. */
+static double switch_crossing(int mode, double t, double h, const double *y, const double *p, const double *sw0,
+                              const double *swd0) {
+    const int nsw = MODE_NSW[mode];
+    double g1[nsw > 0 ? nsw : 1], best = INFINITY;
+    switches(mode, t + h, y, p, g1);
+    for (int k = 0; k < nsw; ++k) {
+        const double g0 = sw0[k];
+        if (g0 == 0.0 || !(g0 > 0.0 ? g1[k] <= 0.0 : g1[k] >= 0.0)) continue;
+        const double a = h * swd0[k], c = g1[k] - g0 - a;
+        double th = g0 / (g0 - g1[k]); /* the secant: the fallback of a degenerate quadratic */
+        const double disc = a * a - 4.0 * c * g0;
+        if (c != 0.0 && disc >= 0.0) { /* stable roots of c θ² + a θ + g0; q(0), q(1) differ in sign */
+            const double q = -0.5 * (a + copysign(sqrt(disc), a));
+            double r1 = q / c, r2 = q != 0.0 ? g0 / q : INFINITY, r = INFINITY;
+            if (r1 > 0.0 && r1 <= 1.0) r = r1;
+            if (r2 > 0.0 && r2 <= 1.0 && r2 < r) r = r2;
+            if (r <= 1.0) th = r;
+        }
+        if (th < best) best = th;
+    }
+    return best <= 1.0 ? best * h : -1.0;
+}
+
+/* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status.
+ *
+ * A kink or jump of the right-hand side at a switching surface inside a trial step spoils its
+ * error estimate in proportion to the part of the step beyond the surface (the stages there see
+ * the other branch): shrinking the step from its start, as the plain control does, keeps the
+ * surface inside it for many rejections. So when a rejected trial ends on the far side of a
+ * switching surface (values sw0 and slopes swd0 at the step's start, the mode's switching part of
+ * the surfaces; NULL: no aiming), the retry is aimed at the estimated crossing (AIM_*): short of
+ * it, or, with the surface just ahead, barely past it; the crossing is then located by the event
+ * logic in the accepted step, which restarts the integrator on the far side. A retry aimed past
+ * the surface whose error does not fall with its overshoot is limited by the smooth part: the
+ * plain control takes over for the rest of the step.
+ * *h_kink: the step size proposed before a switch spoiled the step (the size to resume with
+ * after its crossing), or 0 if none did. */
 AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, double rtol, double atol,
-                    double max_step, double *h_abs) {
+                    double max_step, double *h_abs, const double *sw0, const double *swd0, double *h_kink) {
     const int n = DOP_N(s);
     const double t = s->t_old;
     double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
     double ha = *h_abs;
     if (ha > max_step) ha = max_step;
     if (ha < min_step) ha = min_step;
-    int rejected = 0, saw_nan = 0;
-    double ytmp[NXMAX];
+    int rejected = 0, saw_nan = 0, aiming = sw0 != NULL && MODE_NSW[mode] > 0;
+    double ytmp[NXMAX], err_aimed = INFINITY; /* the error of the last aimed trial */
+    const double ha0 = ha;
+    *h_kink = 0.0;
     for (;;) {
         if (ha < min_step) return saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
         double t_new = t + ha;
@@ -132,8 +186,21 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
             s->dense_ready = 0;
             return 0;
         }
-        ha *= fmax(0.2, 0.9 * pow(error_norm, -1.0 / 8.0));
         rejected = 1;
+        if (aiming && error_norm > 0.25 * err_aimed) aiming = 0; /* not the switch's doing */
+        const double tc = aiming ? switch_crossing(mode, t, h, s->y, p, sw0, swd0) : -1.0;
+        if (tc > 0.0) {
+            *h_kink = ha0;
+            if (tc > AIM_NEAR * ha) { /* end the step short of the surface: no stage beyond it */
+                err_aimed = INFINITY;
+                ha = (1.0 - AIM_SHORT) * tc;
+            } else { /* the surface just ahead: cross it in a step barely longer than the gap */
+                err_aimed = error_norm;
+                ha = tc + (ha - tc) * fmin(0.05, AIM_ERR / error_norm);
+            }
+            continue;
+        }
+        ha *= fmax(0.2, 0.9 * pow(error_norm, -1.0 / 8.0));
     }
 }
 

@@ -89,6 +89,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
     surfaces_dot(mode, t, s.y_old, s.f_old, p, gd_old);
     arm_zero_guards(mode, t, s.y_old, s.f_old, p, s.n, g_old, gd_old, -1);
     int status = -1, zs;
+    /* the step size before a switching surface spoiled a step: resumed once it is crossed */
+    double h_resume = 0.0;
     if ((zs = resolve_zero_switches(mode, t, s.y_old, p, g_old, s.n, -1)) >= 0) {
         ctx[CX_INFO] = MODE_SW0[mode] + (zs - MODE_NTR[mode]);
         status = ST_SLIDING;
@@ -103,10 +105,13 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         double t_bound = t_end;
         if (max_step_time > 0.0 && ctx[CX_TLAST_STEP] + max_step_time < t_bound) t_bound = ctx[CX_TLAST_STEP] + max_step_time;
         s.t_old = t;
-        double h_try = h_abs;
+        double h_try = h_abs, h_kink = 0.0;
+        const double *sw0 = MODE_NSW[mode] > 0 ? g_old + MODE_NTR[mode] : NULL;
         int st = implicit ? radau_step(&s, &rad, mode, p, t_bound, rtol, atol, max_step, &h_try)
-                          : dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try);
+                          : dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try, sw0, sw0 ? gd_old + MODE_NTR[mode] : NULL,
+                                     &h_kink);
         if (st) { status = st; break; }
+        if (h_kink > h_resume) h_resume = h_kink;
         const double t_new = t + s.h;
         const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode], nsf = n_surf(mode);
         double g_new[NTR1];
@@ -169,6 +174,8 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
             /* --- a switching surface: restart the integrator on its far side, or stop if the flow
              * there points back into it (sliding) --- */
             if (recording && sample_dt <= 0.0) put_row(&rec, t_ev, mode, s.n, x_ev);
+            if (h_resume > h_abs) h_abs = h_resume;
+            h_resume = 0.0;
             /* crossings accumulating (a switch chattering about a kink) count towards Zeno */
             if (t_ev - ctx[CX_TPREV_EVENT] < zeno_dt) ctx[CX_ZENO] += 1; else ctx[CX_ZENO] = 0;
             ctx[CX_TPREV_EVENT] = t_ev;
@@ -202,6 +209,7 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         }
         /* --- an event: record, then terminate or reset --- */
         const int tr = tr0 + ev_k;
+        h_resume = 0.0;
         if (recording) put_row(&rec, t_ev, mode, s.n, x_ev);
         double fm[NXMAX];
         if (sens && (st = sens_to_event(&s, mode, p, t, s.y_old, t_ev, x_ev, 0, sens, fm))) { status = st; break; }
