@@ -209,7 +209,8 @@ def run(quick: bool = False) -> Section:
             print(f"  {stop_note}", flush=True)
             break
         if any(s.get("runtime_compiles") for s in samples):
-            raise RuntimeError("a cold build compiled the runtime: the seeded cache did not match its key")
+            raise RuntimeError(f"n = {n}: a cold build compiled the runtime: no seeded object matched "
+                               "its key and capacity")
         amble_stats[n] = Stats.of([s["total_s"] for s in samples])
         # report the breakdown of the median run
         amble_res[n] = sorted(samples, key=lambda s: s["total_s"])[len(samples) // 2]
