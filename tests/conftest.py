@@ -14,3 +14,13 @@ def compass():
     from amble.models import load
 
     return load("compass-gait")
+
+
+@pytest.fixture(scope="module")
+def compass_built():
+    """The library's compass gait and its compiled kernels (its own copy per test module)."""
+    from amble.backend.kernels import build
+    from amble.models import load
+
+    system = load("compass-gait")
+    return system, build(system)

@@ -5,24 +5,15 @@ reads, compares and pickles as a list of :class:`Event`."""
 import pickle
 
 import numpy as np
-import pytest
 
 import amble
-from amble.backend.kernels import build
-from amble.models import load
 from amble.simulation.engine import Options, run
 from amble.simulation.simulate import parameter_vector
 from amble.simulation.trajectory import Event
 
 
-@pytest.fixture(scope="module")
-def compass():
-    system = load("compass-gait")
-    return system, build(system)
-
-
-def test_recorded_run_ends_where_the_fast_path_ends(compass):
-    system, k = compass
+def test_recorded_run_ends_where_the_fast_path_ends(compass_built):
+    system, k = compass_built
     p = parameter_vector(k, None)
     x0 = np.array(system.default_start[k.meta["modes"][0]], float)
     fast = run(k, p, 0, x0, steps=6, opts=Options(max_step_time=system.max_step_time))
@@ -40,8 +31,8 @@ def test_recorded_run_ends_where_the_fast_path_ends(compass):
     np.testing.assert_array_equal(traj.events[-1].x_post, fast.x)
 
 
-def test_events_read_as_a_list(compass):
-    system, _ = compass
+def test_events_read_as_a_list(compass_built):
+    system, _ = compass_built
     traj = amble.simulate(system, steps=3)
     ev = traj.events
     assert len(ev) == 3 and all(isinstance(e, Event) for e in ev)

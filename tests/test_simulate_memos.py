@@ -12,14 +12,8 @@ from amble.simulation.engine import Options, run
 from amble.simulation.simulate import parameter_vector
 
 
-@pytest.fixture(scope="module")
-def compass():
-    system = load("compass-gait")
-    return system, build(system)
-
-
-def test_a_parameter_vector_is_the_defaults_with_the_overrides(compass):
-    system, k = compass
+def test_a_parameter_vector_is_the_defaults_with_the_overrides(compass_built):
+    system, k = compass_built
     names, defaults = k.meta["params"], k.meta["param_defaults"]
     for _ in range(3):  # the first call works it out, the next ones reuse it
         p = parameter_vector(k, {"slope": 0.06, "m": 4}, system)
@@ -34,8 +28,8 @@ def test_a_parameter_vector_is_the_defaults_with_the_overrides(compass):
     assert amble.simulate(system, steps=1).params.tolist() == list(defaults)
 
 
-def test_a_value_refused_once_is_refused_every_time(compass):
-    system, k = compass
+def test_a_value_refused_once_is_refused_every_time(compass_built):
+    system, k = compass_built
     for _ in range(2):
         with pytest.raises(ParameterError, match="outside its domain"):
             parameter_vector(k, {"m": -5.0}, system)
@@ -45,9 +39,9 @@ def test_a_value_refused_once_is_refused_every_time(compass):
             parameter_vector(k, {"nope": 1.0}, system)
 
 
-def test_a_domain_is_checked_on_every_call(compass):
+def test_a_domain_is_checked_on_every_call(compass_built):
     """A vector worked out without a system (no domain check) is still checked when a system comes."""
-    system, k = compass
+    system, k = compass_built
     parameter_vector(k, {"slope": 100.0})  # no system: no domain to check
     with pytest.raises(ParameterError, match="outside its domain"):
         parameter_vector(k, {"slope": 100.0}, system)
@@ -68,8 +62,8 @@ def test_a_new_domain_is_seen_by_the_next_call():
         mode.domains.update(saved)
 
 
-def test_new_options_per_call_give_the_run_of_equal_options(compass):
-    system, k = compass
+def test_new_options_per_call_give_the_run_of_equal_options(compass_built):
+    system, k = compass_built
     x0 = np.array(system.default_start[system.mode_names[0]], float)
     fast = run(k, parameter_vector(k, None), 0, x0, steps=2,
                opts=Options(rtol=1e-8, atol=1e-9, max_step_time=system.max_step_time))
