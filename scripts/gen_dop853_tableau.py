@@ -1,9 +1,9 @@
 """Write src/amble/backend/_c/dop853_tableau.h from SciPy's DOP853 coefficients (Hairer's tableau).
 
-Besides the tables, the header lists the non-zero terms of the dense output's sums (the three
-extra stages and the four coefficient rows) as X-macros, so that the dense-output set-up
-(``_c/dop853_step.h``) is written out with its coefficients as constants: no loop over the
-stages and no test for a zero coefficient at run time.
+Besides the tables, the header lists the non-zero terms of the step's sums (its stages, the
+solution, the two error estimates) and of the dense output's (the three extra stages and the four
+coefficient rows) as X-macros, so that both (``_c/dop853_step.h``) are written out with their
+coefficients as constants: no loop over the stages and no test for a zero coefficient at run time.
 
 Run from the repository root: ``python scripts/gen_dop853_tableau.py``.
 """
@@ -45,7 +45,10 @@ def main() -> None:
         arr("DOP_E3", c.E3),
         arr("DOP_E5", c.E5),
         arr("DOP_D", c.D.ravel()),
-        "/* The dense output's sums, non-zero terms only: T(stage j, coefficient(s) of K[j]). */\n",
+        "/* The step's and the dense output's sums, non-zero terms only: T(stage j, coefficient(s) of K[j]). */\n",
+        *(terms(f"DOP_A{st}_TERMS", [c.A[st]]) for st in range(1, c.N_STAGES)),
+        terms("DOP_B_TERMS", [c.B]),
+        terms("DOP_E_TERMS", [c.E5, c.E3]),
         *(terms(f"DOP_A{st}_TERMS", [c.A[st]]) for st in ext),
         terms("DOP_D_TERMS", c.D),
     ]

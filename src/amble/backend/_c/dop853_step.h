@@ -93,6 +93,22 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
     return best <= 1.0 ? best * h : -1.0;
 }
 
+/* The step's sums written out over the tableau's non-zero terms (the X-macro lists of
+ * dop853_tableau.h), the coefficients as constants, as the dense output's below: per component the
+ * additions are those of the plain sum over all stages, in its order (from 0.0, zeros skipped), so
+ * the results are bitwise those of the loop over the tableau with a zero test per coefficient. */
+#define DOP_ADD_TERM(j, c) a += (c) * s->K[j][i];
+#define DOP_ADD_E(j, c5, c3) { const double k = s->K[j][i]; a5 += (c5) * k; a3 += (c3) * k; }
+#define DOP_STEP_STAGE(st)                                                                     \
+    if (!err) {                                                                                \
+        for (int i = 0; i < n; ++i) {                                                          \
+            double a = 0.0;                                                                    \
+            DOP_A##st##_TERMS(DOP_ADD_TERM)                                                    \
+            ytmp[i] = s->y_old[i] + h * a;                                                     \
+        }                                                                                      \
+        err = rhs(mode, t + DOP_C[st] * h, ytmp, p, s->K[st]);                                 \
+    }
+
 /* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status.
  *
  * A kink or jump of the right-hand side at a switching surface inside a trial step spoils its
@@ -127,44 +143,23 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
         ha = fabs(h);
         for (int i = 0; i < n; ++i) s->K[0][i] = s->f_old[i];
         int err = 0;
-        /* Stage sums run over the stages outermost (an independent accumulator per component) and
-         * skip the tableau's zeros; per component the additions are those of the plain sum, in
-         * its order, so the results are bitwise the same. */
-        double acc[NXMAX], a3[NXMAX];
-        for (int st = 1; st < DOP_STAGES && !err; ++st) {
-            const double *a = DOP_A + st * DOP_STAGES_EXT;
-            for (int i = 0; i < n; ++i) acc[i] = 0.0;
-            for (int j = 0; j < st; ++j) {
-                const double c = a[j];
-                if (c == 0.0) continue;
-                for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
-            }
-            for (int i = 0; i < n; ++i) ytmp[i] = s->y_old[i] + h * acc[i];
-            err = rhs(mode, t + DOP_C[st] * h, ytmp, p, s->K[st]);
-        }
+        DOP_STEP_STAGE(1) DOP_STEP_STAGE(2) DOP_STEP_STAGE(3) DOP_STEP_STAGE(4) DOP_STEP_STAGE(5)
+        DOP_STEP_STAGE(6) DOP_STEP_STAGE(7) DOP_STEP_STAGE(8) DOP_STEP_STAGE(9) DOP_STEP_STAGE(10)
+        DOP_STEP_STAGE(11)
         if (err) return ST_SINGULAR_MASS;
-        for (int i = 0; i < n; ++i) acc[i] = 0.0;
-        for (int j = 0; j < DOP_STAGES; ++j) {
-            const double c = DOP_B[j];
-            if (c == 0.0) continue;
-            for (int i = 0; i < n; ++i) acc[i] += c * s->K[j][i];
+        for (int i = 0; i < n; ++i) {
+            double a = 0.0;
+            DOP_B_TERMS(DOP_ADD_TERM)
+            s->y[i] = s->y_old[i] + h * a;
         }
-        for (int i = 0; i < n; ++i) s->y[i] = s->y_old[i] + h * acc[i];
         if (rhs(mode, t + h, s->y, p, s->K[DOP_STAGES])) return ST_SINGULAR_MASS;
-        for (int i = 0; i < n; ++i) acc[i] = a3[i] = 0.0; /* acc: the 5th-order error, a3: the 3rd */
-        for (int j = 0; j <= DOP_STAGES; ++j) {
-            const double c5 = DOP_E5[j], c3 = DOP_E3[j];
-            if (c5 == 0.0 && c3 == 0.0) continue;
-            for (int i = 0; i < n; ++i) {
-                acc[i] += c5 * s->K[j][i];
-                a3[i] += c3 * s->K[j][i];
-            }
-        }
         double e5 = 0.0, e3 = 0.0;
         for (int i = 0; i < n; ++i) {
+            double a5 = 0.0, a3 = 0.0; /* the 5th- and the 3rd-order error estimates */
+            DOP_E_TERMS(DOP_ADD_E)
             const double ya = fabs(s->y_old[i]), yb = fabs(s->y[i]);
             const double sc = atol + (ya > yb ? ya : yb) * rtol; /* fmax is a library call at -O2 */
-            const double b5 = acc[i] / sc, b3 = a3[i] / sc;
+            const double b5 = a5 / sc, b3 = a3 / sc;
             e5 += b5 * b5;
             e3 += b3 * b3;
         }
@@ -210,7 +205,6 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
  * instructions (callgrind, compass gait). Per component the additions are those of the plain
  * sum over all stages, in its order (from 0.0, zeros skipped), so the result is bitwise the same;
  * the four coefficient rows are summed in one pass, each K[j] read once for all four. */
-#define DOP_ADD_TERM(j, c) a += (c) * s->K[j][i];
 #define DOP_ADD_D(j, c0, c1, c2, c3) { const double k = s->K[j][i]; d0 += (c0) * k; d1 += (c1) * k; \
                                        d2 += (c2) * k; d3 += (c3) * k; }
 #define DOP_EXTRA_STAGE(st)                                                                    \
