@@ -220,6 +220,7 @@ def _unhoisted(system: Any) -> Any:
 
     from amble.backend import cache
     from amble.backend.codegen import generate
+    from amble.backend.files import write_atomic
     from amble.backend.kernels import Kernels
 
     key = hashlib.sha256(f"{cache.structure_key(system)}:no-hoist-dense".encode()).hexdigest()[:24]
@@ -229,7 +230,7 @@ def _unhoisted(system: Any) -> Any:
         src, meta = generate(system, hoist_params=False)
         so, digest = cache._compile(src, key, d)
         meta = {**meta, "library": so.name, "library_sha256": digest}
-        cache._write_atomic(d / f"{key}.json", json.dumps(meta).encode())
+        write_atomic(d / f"{key}.json", json.dumps(meta).encode())
         hit = (so, meta)
     return Kernels(*hit)
 

@@ -55,6 +55,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import CompileError
 from ..version import __version__
 from .digest import sha256
+from .files import sha256_of, write_atomic
 from .units import run_compilers, split_units
 
 # shutil, subprocess, tempfile and the runtime's builder (.runtime) are imported where a library is
@@ -290,7 +291,7 @@ def cached(d: Path, key: str) -> tuple[Path, dict] | None:
     try:
         meta = json.loads((d / f"{key}.json").read_text())
         so = d / meta["library"]
-        ok = so.parent == d and _sha256(so) == meta["library_sha256"]
+        ok = so.parent == d and sha256_of(so) == meta["library_sha256"]
     except (OSError, ValueError, KeyError, TypeError):
         return None
     return (so, meta) if ok else None
@@ -305,19 +306,9 @@ def rebuild(system: HybridSystem, key: str, d: Path | None = None, derivatives: 
     src, meta = generate(system, derivatives=derivatives)
     so, digest = _compile(src, key, d)
     meta = {**meta, "library": so.name, "library_sha256": digest}
-    _write_atomic(d / f"{key}.json", json.dumps(meta).encode())
-    _write_atomic(so.with_suffix(".c"), src.encode())  # the generated source, for inspection
+    write_atomic(d / f"{key}.json", json.dumps(meta).encode())
+    write_atomic(so.with_suffix(".c"), src.encode())  # the generated source, for inspection
     return so, meta
-
-
-def _sha256(path: Path) -> str:
-    return sha256(path.read_bytes()).hexdigest()
-
-
-def _write_atomic(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
 
 
 def _remove_orphans(d: Path) -> None:
@@ -366,7 +357,7 @@ def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
             run_compilers([[*base, "-shared", *map(str, objs), *linked, "-o", str(out), "-lm"]], cc)
         if not out.is_file() or out.stat().st_size == 0:
             raise CompileError(f"C compiler {cc!r} reported success but wrote no library")
-        digest = _sha256(out)
+        digest = sha256_of(out)
         so = d / f"{key}-{digest[:16]}.so"
         os.replace(out, so)
     return so, digest

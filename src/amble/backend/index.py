@@ -43,6 +43,7 @@ from ..version import __version__
 from . import cache
 from .compiled import FORMAT, CompiledSystem, describe
 from .digest import sha256
+from .files import write_atomic
 from .stamps import stamped_digest
 
 if TYPE_CHECKING:
@@ -142,7 +143,7 @@ def record(spec: str, sources: Sequence[Path], system: HybridSystem, files: Sequ
             "system": describe(system),
         }
         data = json.dumps(entry).encode()
-        cache._write_atomic(path, data)
+        write_atomic(path, data)
     except (AmbleError, OSError, AttributeError, TypeError, ValueError):
         return None
     return path

@@ -24,7 +24,6 @@ is a function of the model's structure.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import re
@@ -34,6 +33,8 @@ from typing import NamedTuple
 
 from ..errors import CompileError
 from . import abi
+from .digest import sha256
+from .files import sha256_of, write_atomic
 from .units import run_compilers
 
 C_DIR = Path(__file__).resolve().parent / "_c"  # a package on disk (importlib.resources costs ~10 ms)
@@ -78,7 +79,7 @@ class Toolchain(NamedTuple):
 
 def runtime_key(cap: int, tc: Toolchain) -> str:
     """Cache key of the runtime object of capacity ``cap`` built with ``tc``."""
-    h = hashlib.sha256(_sources_digest().encode())
+    h = sha256(_sources_digest().encode())
     h.update(tc.identity.encode())
     h.update(f"\0{CAPACITY_MACRO}={cap}".encode())
     return h.hexdigest()[:24]
@@ -88,7 +89,7 @@ def runtime_key(cap: int, tc: Toolchain) -> str:
 def _sources_digest() -> str:
     """Hash of the engine's C sources and the Python↔C header, once per process (as the model
     libraries' own :func:`amble.backend.cache.source_digest`)."""
-    h = hashlib.sha256(b"amble-runtime\0")
+    h = sha256(b"amble-runtime\0")
     for f in sorted(C_DIR.iterdir()):
         if f.suffix in (".c", ".h"):
             h.update(f.name.encode() + b"\0" + f.read_bytes())
@@ -102,7 +103,7 @@ def cached_object(d: Path, cap: int, tc: Toolchain) -> Path | None:
     try:
         meta = json.loads((d / f"runtime-{key}.json").read_text())
         obj = d / meta["object"]
-        ok = obj.parent == d and meta["capacity"] == cap and _sha256(obj) == meta["sha256"]
+        ok = obj.parent == d and meta["capacity"] == cap and sha256_of(obj) == meta["sha256"]
     except (OSError, ValueError, KeyError, TypeError):
         return None
     return obj if ok else None
@@ -130,19 +131,9 @@ def build(d: Path, cap: int, tc: Toolchain) -> Path:
         COMPILES += 1
         if not out.is_file() or out.stat().st_size == 0:
             raise CompileError(f"C compiler {cc!r} reported success but wrote no library (the amble runtime object)")
-        digest = _sha256(out)
+        digest = sha256_of(out)
         obj = d / f"runtime-{key}-{digest[:16]}.o"
         os.replace(out, obj)
-    _write_atomic(d / f"runtime-{key}.json", json.dumps({"object": obj.name, "sha256": digest,
+    write_atomic(d / f"runtime-{key}.json", json.dumps({"object": obj.name, "sha256": digest,
                                                           "capacity": cap}).encode())
     return obj
-
-
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def _write_atomic(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
