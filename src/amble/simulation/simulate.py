@@ -26,17 +26,37 @@ if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
 
 
+class _Memo:
+    """Values worked out once per call site's inputs, keyed by a tuple that starts with the id of
+    the object they belong to. That object's identity is checked on every hit (an id is reused
+    once its object is gone), and the table is emptied at ``limit`` entries (callers that make a
+    new object or value per call would fill it)."""
+
+    def __init__(self, limit: int) -> None:
+        self._table: dict[tuple, tuple[Any, Any]] = {}
+        self._limit = limit
+
+    def get(self, key: tuple, owner: Any) -> Any:
+        hit = self._table.get(key)
+        return hit[1] if hit is not None and hit[0] is owner else None
+
+    def put(self, key: tuple, owner: Any, value: Any) -> None:
+        if len(self._table) >= self._limit:
+            self._table.clear()
+        self._table[key] = (owner, value)
+
+
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
                      ) -> np.ndarray:
     """Defaults overridden by ``params``; unknown names, non-finite values and (given the
     ``system``) values outside a parameter's declared domain are :class:`ParameterError`.
     A new array on every call (callers keep it: a trajectory's ``params``)."""
     key = _parameter_key(k, params)
-    hit = _PARAMETERS.get(key) if key is not None else None
-    if hit is not None and hit[0] is k:
-        if system is not None and hit[2]:
-            system.check_parameters(hit[2])  # domains are the system's: checked on every call
-        return hit[1].copy()
+    hit = _PARAMETERS.get(key, k) if key is not None else None
+    if hit is not None:
+        if system is not None and hit[1]:
+            system.check_parameters(hit[1])  # domains are the system's: checked on every call
+        return hit[0].copy()
     names = k.meta["params"]
     p = np.array(k.meta["param_defaults"], dtype=float)
     if params is not None and not isinstance(params, Mapping):  # a list of pairs or of names reads ambiguously
@@ -60,16 +80,15 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: Hyb
     if p.size == 0:
         p = np.zeros(1)
     if key is not None:
-        if len(_PARAMETERS) >= 256:  # bounded: a sweep passes a new value on every call
-            _PARAMETERS.clear()
-        _PARAMETERS[key] = (k, p, given)
+        _PARAMETERS.put(key, k, (p, given))
         return p.copy()
     return p
 
 
-#: Parameter vectors by (id of the kernels, the overrides as given) → (kernels, vector, the
-#: overrides as checked against the domains): names, numbers and finiteness are checked once.
-_PARAMETERS: dict[tuple, tuple[Kernels, np.ndarray, dict[str, float]]] = {}
+#: Parameter vectors by (id of the kernels, the overrides as given) → (vector, the overrides as
+#: checked against the domains): names, numbers and finiteness are checked once; a sweep passes a
+#: new value on every call, hence the bound.
+_PARAMETERS = _Memo(256)
 
 
 def _parameter_key(k: Kernels, params: Any) -> tuple | None:
@@ -233,9 +252,8 @@ def _count(value: Any, what: str, most: int) -> int | None:
 #: The options of a call that gives none.
 _DEFAULT_OPTIONS = Options()
 
-#: Options by (id(base), rtol, atol, max_step_time, method) → (base, options): the identity of
-#: ``base`` is checked on every hit (an id is reused once its object is gone).
-_OPTIONS: dict[tuple, tuple[Options, Options]] = {}
+#: Options by (id(base), rtol, atol, max_step_time, method).
+_OPTIONS = _Memo(64)
 
 
 def _options(base: Options, rtol: float, atol: float, max_step_time: float, method: str) -> Options:
@@ -244,13 +262,10 @@ def _options(base: Options, rtol: float, atol: float, max_step_time: float, meth
     Keyed by the identity of ``base`` (hashing a frozen dataclass of eleven fields took longer
     than the rest of the lookup); a new ``Options`` per call still gets equal results."""
     key = (id(base), rtol, atol, max_step_time, method)
-    hit = _OPTIONS.get(key)
-    if hit is not None and hit[0] is base:
-        return hit[1]
-    if len(_OPTIONS) >= 64:  # bounded: callers that make an Options per call would fill it
-        _OPTIONS.clear()
-    opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=max_step_time, method=method)
-    _OPTIONS[key] = (base, opts)
+    opts = _OPTIONS.get(key, base)
+    if opts is None:
+        opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=max_step_time, method=method)
+        _OPTIONS.put(key, base, opts)
     return opts
 
 
@@ -267,22 +282,19 @@ def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
                       kernels=k, final_state=r.x, final_mode=meta["modes"][r.mode])
 
 
-#: Per transition list (by identity, checked on every hit): its names and the state lengths on
-#: either side, as :class:`Events` reads them.
-_KINDS: dict[int, tuple[list, list]] = {}
+#: Per transition list (by its id): its names and the state lengths on either side, as
+#: :class:`Events` reads them.
+_KINDS = _Memo(64)
 
 
 def _kinds(meta: dict) -> list[tuple[str, str, str, int, int]]:
     trs = meta["transitions"]
-    hit = _KINDS.get(id(trs))
-    if hit is not None and hit[0] is trs:
-        return hit[1]
-    modes, nx = meta["modes"], meta["nx"]
-    kinds = [(tr["name"], tr["source"], tr["target"], nx[modes.index(tr["source"])], nx[modes.index(tr["target"])])
-             for tr in trs]
-    if len(_KINDS) >= 64:
-        _KINDS.clear()
-    _KINDS[id(trs)] = (trs, kinds)
+    kinds = _KINDS.get((id(trs),), trs)
+    if kinds is None:
+        modes, nx = meta["modes"], meta["nx"]
+        kinds = [(tr["name"], tr["source"], tr["target"], nx[modes.index(tr["source"])],
+                  nx[modes.index(tr["target"])]) for tr in trs]
+        _KINDS.put((id(trs),), trs, kinds)
     return kinds
 
 
