@@ -82,12 +82,12 @@ def chain(n: int):
 
 
 def _timer(tmp: Path):
-    """The C timing loop, compiled here (the same compiler and -O2 as the generated code)."""
-    from amble.backend.cache import compiler
+    """The C timing loop, compiled here (the same compiler and flags as the generated code)."""
+    from amble.backend.cache import cflags, compiler
 
     src, so = tmp / "timer.c", tmp / "timer.so"
     src.write_text(_TIMER_C)
-    subprocess.run([*compiler().split(), "-O2", "-fPIC", "-shared", str(src), "-o", str(so)], check=True)
+    subprocess.run([*compiler().split(), *cflags(), "-fPIC", "-shared", str(src), "-o", str(so)], check=True)
     lib = ctypes.CDLL(str(so))
     lib.amble_bench_rhs.restype = ctypes.c_double
     return lib

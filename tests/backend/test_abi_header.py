@@ -20,6 +20,7 @@ def test_header_equals_the_tables():
     assert cx == {**abi.CTX, "X": abi.CTX_X}
     assert {k[3:]: v for k, v in d.items() if k.startswith("OP_")} == abi.OPT
     assert {k[3:]: v for k, v in d.items() if k.startswith("IO_")} == abi.IOPT
+    assert d["IOPT_LEN"] == len(abi.IOPT)  # what a C copy of the integer options covers
     assert d["AMBLE_LAYOUT"] == abi.LAYOUT
     assert "#include <stdint.h>" in abi.c_header()
 

@@ -128,7 +128,7 @@ def c_header(layout: int | None = None) -> str:
     lines += [f"#define ST_{name} {code}" for code, name, _ in STATUS]
     lines += [f"#define CX_{name} {i}" for name, i in CTX.items()] + [f"#define CX_X {CTX_X}"]
     lines += [f"#define OP_{name} {i}" for name, i in OPT.items()]
-    lines += [f"#define IO_{name} {i}" for name, i in IOPT.items()]
+    lines += [f"#define IO_{name} {i}" for name, i in IOPT.items()] + [f"#define IOPT_LEN {len(IOPT)}"]
     lines += [f"#define SENS_{name} {_sens_c(c)}" for name, c in _sens_offsets().items()]
     lines.append(f"#define AMBLE_LAYOUT {LAYOUT if layout is None else layout}LL")
     return "\n".join(lines) + "\n"

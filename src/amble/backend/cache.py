@@ -1,6 +1,7 @@
 """The on-disk cache of compiled systems: where it is, what a library's key covers, how it is built.
 
-A library is cached under ``<name>-<key>.so`` with its loader metadata in ``<name>-<key>.json``.
+A library is cached under ``<key>-<sha>.so`` (``<sha>``: its content hash) with its loader
+metadata in ``<key>.json``.
 The key is a hash of everything that shapes the compiled library:
 
 * the system's *structure* — symbolic positions, masses, energies, forces, guards and resets,
@@ -8,7 +9,9 @@ The key is a hash of everything that shapes the compiled library:
 * the sources that generate and compile it: the C engine (``backend/_c``), the backend, the
   derivation, and the modelling layer that feeds them (``modelling/*.py``: trees, DAG tools),
   and the amble version;
-* the toolchain: ``$CC`` (or the compiler found), its ``--version`` output, and ``$AMBLE_CFLAGS``.
+* the toolchain: ``$CC`` (or the compiler found), its ``--version`` output, and the flags
+  (``$AMBLE_CFLAGS``, or the default: code for this machine's processor, whose identity is then
+  part of the key — :mod:`amble.backend.host`).
 
 The package sources are hashed once per process and the compiler identity once per compiler.
 A system's structural hash is computed once per system object: systems are mutable dataclasses
@@ -54,6 +57,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import CompileError
 from ..version import __version__
+from . import host
 from .digest import sha256
 from .files import sha256_of, write_atomic
 from .units import run_compilers, split_units
@@ -167,7 +171,8 @@ def _find_compiler(env_cc: str, path: str) -> str:
 
 
 def cflags() -> list[str]:
-    return os.environ.get("AMBLE_CFLAGS", "-O2").split()
+    """The flags the compiler is given (:mod:`amble.backend.host`: native code by default)."""
+    return host.cflags(compiler())
 
 
 @lru_cache(maxsize=16)
@@ -183,9 +188,10 @@ def compiler_identity(cc: str) -> str:
 
 
 def toolchain() -> str:
-    """Compiler command, its identity and the flags, as one string."""
+    """Compiler command, its identity and the flags (as given and as set: with native code the
+    processor's identity), as one string."""
     cc = compiler()
-    return "\0".join([cc, compiler_identity(cc), *cflags()])
+    return "\0".join([cc, compiler_identity(cc), *cflags(), host.flags_setting()])
 
 
 def runtime_toolchain() -> runtime.Toolchain:
@@ -257,7 +263,7 @@ def _forget(sid: int) -> Any:
 def structure_key(system: HybridSystem) -> str:
     """Cache key of a system's library: its structure, the generating sources, the toolchain."""
     env = os.environ
-    return _key(_structure(system), env.get("CC") or "", env.get("AMBLE_CFLAGS", "-O2"), env.get("PATH") or "")
+    return _key(_structure(system), env.get("CC") or "", host.flags_setting(), env.get("PATH") or "")
 
 
 @lru_cache(maxsize=256)

@@ -213,7 +213,8 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         w("    (void)t; (void)x; (void)p;\n")
         w(f"    for (int i = 0; i < {3 * len(points)}; ++i) {{ pos[i] = NAN; vel[i] = NAN; }}\n")
         w(blk(tg, ex, nm, shared=m.tree is not None))
-        w("}\n\n")
+        w("}\n")
+        w(_rhs_surfaces_code(k, 2 * n, len(trs), len(sws)))
 
     # transitions: enabling conditions and resets
     for i, tr in enumerate(order):
@@ -245,6 +246,8 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
     mode_list = list(modes)
     dispatch("rhs(int mode, double t, const double *x, const double *p, double *dx)", "int",
              "rhs_{}(t, x, p, dx)", mode_list, "mode")
+    dispatch("rhs_surfaces(int mode, double t, const double *x, const double *p, double *dx, double *g, double *gd)",
+             "int", "rhs_surfaces_{}(t, x, p, dx, g, gd)", mode_list, "mode")
     dispatch("guards(int mode, double t, const double *x, const double *p, double *g)", "void",
              "guards_{}(t, x, p, g)", mode_list, "mode")
     dispatch("guards_dot(int mode, double t, const double *x, const double *dx, const double *p, double *g)",
@@ -292,6 +295,30 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         "derivatives": derivatives,
     }
     return "".join(out), meta
+
+
+def _rhs_surfaces_code(k: int, nx: int, ntr: int, nsw: int) -> str:
+    """``rhs_surfaces_k``: the right-hand side, then the mode's surfaces (guards, then switching
+    surfaces) and their rates along it, at one point — the last stage of every integrator step,
+    whose surfaces the event screening needs. Flattened (every kernel inlined into one body), the
+    terms the kernels share, above all the sines and cosines of the coordinates, are computed once
+    by the C compiler's common-subexpression elimination; each surface is the same expression as in
+    ``guards_k`` (no reassociation), so the values are those of the separate kernels."""
+    # the state is copied: stores through dx could otherwise alias x, and every x[i] read after
+    # them would be a new value to the compiler (its sines recomputed)
+    body = [f"static AMBLE_FLATTEN int rhs_surfaces_{k}(double t, const double *x0, const double *p, double *dx,"
+            " double *g, double *gd) {\n",
+            f"    double x[{nx}];\n",
+            f"    for (int i = 0; i < {nx}; ++i) x[i] = x0[i];\n",
+            f"    const int err = rhs_{k}(t, x, p, dx);\n",
+            "    if (err) return err;\n"]
+    if ntr:
+        body += [f"    guards_{k}(t, x, p, g);\n", f"    guards_dot_{k}(t, x, dx, p, gd);\n"]
+    if nsw:
+        body += [f"    switches_{k}(t, x, p, g + {ntr});\n", f"    switches_dot_{k}(t, x, dx, p, gd + {ntr});\n"]
+    if not ntr and not nsw:
+        body.append("    (void)g; (void)gd;\n")
+    return "".join(body) + "    return 0;\n}\n\n"
 
 
 def _enabled_code(enabled: Any, nm: dict) -> str:

@@ -10,10 +10,11 @@ importing SymPy. The index finds it from what the model is *made of* instead. It
 * amble's version and the sources that the library key covers (the C engine, the backend, the
   derivation and the modelling layer, :func:`amble.backend.cache.source_digest`), and the package
   root that maps the public names to them;
-* ``$CC`` and ``$AMBLE_CFLAGS`` (not the compiler found on the ``PATH`` nor its ``--version``:
-  finding and running it is the price of a subprocess; a compiler upgraded in place, or another
-  found first on the ``PATH``, keeps serving the library the previous one built, which computes
-  the same model).
+* ``$CC`` and the flags setting (``$AMBLE_CFLAGS`` or the default, with native code the
+  processor's identity: :func:`amble.backend.host.flags_setting`; not the compiler found on the
+  ``PATH`` nor its ``--version``: finding and running it is the price of a subprocess; a
+  compiler upgraded in place, or another found first on the ``PATH``, keeps serving the library
+  the previous one built, which computes the same model).
 
 Parameter values (``--set``) do not enter: they are run-time inputs of every library. An entry
 holds the library key of the system (:func:`~amble.backend.cache.structure_key`), the SHA-256 of
@@ -40,7 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import AmbleError
 from ..version import __version__
-from . import cache
+from . import cache, host
 from .compiled import FORMAT, CompiledSystem, describe
 from .digest import sha256
 from .files import write_atomic
@@ -63,7 +64,7 @@ def index_key(spec: str, sources: Sequence[Path]) -> str:
     h = sha256(f"amble-index\0{FORMAT}\0{__version__}\0{spec}\0".encode())
     h.update(cache.source_digest().encode())
     h.update(_ROOT_INIT.read_bytes())
-    h.update(f"\0{os.environ.get('CC', '')}\0{os.environ.get('AMBLE_CFLAGS', '-O2')}\0".encode())
+    h.update(f"\0{os.environ.get('CC', '')}\0{host.flags_setting()}\0".encode())
     for f in sources:
         h.update(f"{f}\0".encode())
         h.update(Path(f).read_bytes())
@@ -77,7 +78,7 @@ def entry_path(spec: str, sources: Sequence[Path], d: Path | None = None) -> Pat
     files = [*cache.source_files(), _ROOT_INIT, *map(Path, sources)]
     env = os.environ
     ident = "\0".join(["amble-index", str(FORMAT), __version__, spec, env.get("CC", ""),
-                       env.get("AMBLE_CFLAGS", "-O2"), *map(str, files)])
+                       host.flags_setting(), *map(str, files)])
     return d / f"index-{stamped_digest(d, ident, files, lambda: index_key(spec, sources))}.json"
 
 

@@ -16,6 +16,13 @@
 #else
 #define AMBLE_INLINE inline
 #endif
+/* Inline every call of a function into its body, so that the kernels it calls at one point share
+ * their common terms (codegen.py: rhs_surfaces_k). */
+#if defined(__GNUC__) || defined(__clang__)
+#define AMBLE_FLATTEN __attribute__((flatten))
+#else
+#define AMBLE_FLATTEN
+#endif
 
 /* A kernel compiled in a translation unit of its own (backend/cache.py: the two units of a large
  * model compile in parallel) and linked into the same library: called directly, not exported. */

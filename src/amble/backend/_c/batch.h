@@ -36,8 +36,8 @@ static void batch_ctx(double *ctx, int mode, const double *x) {
 void amble_walk_batch(int64_t n, int64_t *next, int mode, const double *x0, const double *p, const double *opt,
                       const int64_t *iopt_in, const double *xref, int64_t steps, int64_t check_every, double tol,
                       int *code, int *info, int64_t *done_steps, double *dist, double *x_out) {
-    int64_t iopt[IO_YIELDN + 1];
-    for (int i = 0; i <= IO_YIELDN; ++i) iopt[i] = iopt_in[i];
+    int64_t iopt[IOPT_LEN]; /* every field: the run reads them all (IO_METHOD picks the integrator) */
+    for (int i = 0; i < IOPT_LEN; ++i) iopt[i] = iopt_in[i];
     iopt[IO_OUTCAP] = iopt[IO_EVCAP] = 0;
     iopt[IO_YIELDN] = 0; /* no pauses for Python's signal handling inside a block */
     if (check_every < 1) check_every = 1;

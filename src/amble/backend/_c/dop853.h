@@ -34,9 +34,11 @@ AMBLE_HIDDEN double initial_step(int mode, double t, const double *y, const doub
 /* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status. A
  * rejected trial that crosses a switching surface (sw0, swd0: the mode's switching values and
  * slopes at the start, or NULL) is retried aimed at it; *h_kink is then the step size
- * proposed before it, else 0. */
+ * proposed before it, else 0. g_new, gd_new (or NULL): the mode's surfaces and their rates at the
+ * step's end, evaluated with its last stage. */
 AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, double rtol, double atol,
-                          double max_step, double *h_abs, const double *sw0, const double *swd0, double *h_kink);
+                          double max_step, double *h_abs, const double *sw0, const double *swd0, double *h_kink,
+                          double *g_new, double *gd_new);
 /* The 7th-order continuous extension of the last step (three extra stages); 0 or ST_SINGULAR_MASS. */
 AMBLE_HIDDEN int dop_dense_prepare(Dop *s, int mode, const double *p);
 /* The dense output of the last step at t. */

@@ -9,6 +9,7 @@
  *
  * Needs from the including unit: the ST_* codes (generated from abi.py), NXMAX and
  *   int rhs(int mode, double t, const double *x, const double *p, double *dx);
+ *   int rhs_surfaces(int mode, double t, const double *x, const double *p, double *dx, double *g, double *gd);
  */
 #ifndef AMBLE_DOP853_STEP_H
 #define AMBLE_DOP853_STEP_H
@@ -122,9 +123,11 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
  * the surface whose error does not fall with its overshoot is limited by the smooth part: the
  * plain control takes over for the rest of the step.
  * *h_kink: the step size proposed before a switch spoiled the step (the size to resume with
- * after its crossing), or 0 if none did. */
+ * after its crossing), or 0 if none did. g_new, gd_new (or NULL): the mode's surfaces and their
+ * rates at the accepted step's end, computed with its last stage (rhs_surfaces). */
 AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, double rtol, double atol,
-                    double max_step, double *h_abs, const double *sw0, const double *swd0, double *h_kink) {
+                    double max_step, double *h_abs, const double *sw0, const double *swd0, double *h_kink,
+                    double *g_new, double *gd_new) {
     const int n = DOP_N(s);
     const double t = s->t_old;
     double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
@@ -152,7 +155,10 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
             DOP_B_TERMS(DOP_ADD_TERM)
             s->y[i] = s->y_old[i] + h * a;
         }
-        if (rhs(mode, t + h, s->y, p, s->K[DOP_STAGES])) return ST_SINGULAR_MASS;
+        /* the last stage, at the step's end: with the surfaces the event screening reads there */
+        if (g_new ? rhs_surfaces(mode, t + h, s->y, p, s->K[DOP_STAGES], g_new, gd_new)
+                  : rhs(mode, t + h, s->y, p, s->K[DOP_STAGES]))
+            return ST_SINGULAR_MASS;
         double e5 = 0.0, e3 = 0.0;
         for (int i = 0; i < n; ++i) {
             double a5 = 0.0, a3 = 0.0; /* the 5th- and the 3rd-order error estimates */

@@ -386,11 +386,11 @@ static int refine_dips(Dop *s, int mode, const double *p, double gtol_abs, doubl
     return ns;
 }
 
-/* Event of the step just taken from (t, g_old, gd_old) to (t_new, g_new): fills gd_new (ġ at
- * t_new), sets *ev_k (guard index within the mode, or -1), *t_ev and x_ev. Returns 0 or
+/* Event of the step just taken from (t, g_old, gd_old) to (t_new, g_new, gd_new: ġ at t_new):
+ * sets *ev_k (guard index within the mode, or -1), *t_ev and x_ev. Returns 0 or
  * ST_SINGULAR_MASS (the dense output could not be built). */
 static int find_event(Dop *s, int mode, const double *p, int nsub, double t, double t_new,
-                      const double *g_old, const double *gd_old, const double *g_new, double *gd_new,
+                      const double *g_old, const double *gd_old, const double *g_new, const double *gd_new,
                       int *ev_k, double *t_ev, double *x_ev, double *from, double t_min,
                       double gtol_abs, double gtol_rel) {
     const int ntr = n_surf(mode);
@@ -398,7 +398,6 @@ static int find_event(Dop *s, int mode, const double *p, int nsub, double t, dou
     *t_ev = INFINITY;
     if (ntr <= 0) return 0;
     double th[NSAMP_MAX];
-    surfaces_dot(mode, t_new, s->y, s->f, p, gd_new);
     int ns = sample_times(s->h, ntr, nsub, g_old, gd_old, g_new, gd_new, th);
     double gs[NSAMP_MAX][NTR1];
     int skip[NTR1], dips = 0;

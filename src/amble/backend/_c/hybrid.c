@@ -105,17 +105,20 @@ int amble_simulate(const double *p, double *ctx, const double *opt, const int64_
         double t_bound = t_end;
         if (max_step_time > 0.0 && ctx[CX_TLAST_STEP] + max_step_time < t_bound) t_bound = ctx[CX_TLAST_STEP] + max_step_time;
         s.t_old = t;
-        double h_try = h_abs, h_kink = 0.0;
+        double h_try = h_abs, h_kink = 0.0, g_new[NTR1];
         const double *sw0 = MODE_NSW[mode] > 0 ? g_old + MODE_NTR[mode] : NULL;
         int st = implicit ? radau_step(&s, &rad, mode, p, t_bound, rtol, atol, max_step, &h_try)
                           : dop_step(&s, mode, p, t_bound, rtol, atol, max_step, &h_try, sw0, sw0 ? gd_old + MODE_NTR[mode] : NULL,
-                                     &h_kink);
+                                     &h_kink, g_new, gd_new);
         if (st) { status = st; break; }
         if (h_kink > h_resume) h_resume = h_kink;
         const double t_new = t + s.h;
         const int ntr = MODE_NTR[mode], tr0 = MODE_TR0[mode], nsf = n_surf(mode);
-        double g_new[NTR1];
-        surfaces(mode, t_new, s.y, p, g_new);
+        /* the explicit step evaluated the surfaces and their rates at its end with its last stage */
+        if (implicit) {
+            surfaces(mode, t_new, s.y, p, g_new);
+            surfaces_dot(mode, t_new, s.y, s.f, p, gd_new);
+        }
         int ev_k;
         double t_ev, x_ev[NXMAX], from = 0.0;
         if ((st = find_event(&s, mode, p, nsub, t, t_new, g_old, gd_old, g_new, gd_new, &ev_k, &t_ev, x_ev, &from, ctx[CX_TLAST_STEP],
