@@ -80,6 +80,30 @@ def _usage(name: str, sub: argparse.ArgumentParser) -> str:
     return " ".join(words)
 
 
+def _epilog_example(sub: argparse.ArgumentParser) -> str | None:
+    """The example in a parser's epilog (``example:`` and an indented line), if it has one."""
+    head, found, rest = (sub.epilog or "").partition("example:\n")
+    return rest.strip() if found and not head.strip() else None
+
+
+def _section(name: str, sub: argparse.ArgumentParser, level: str, example: str | None) -> list[str]:
+    """The reference of one command (or one action of a command): purpose, usage, arguments, example."""
+    out = [f"{level} amble {name}\n"]
+    desc = sub.description or ""
+    out.append(f"{desc[:1].upper()}{desc[1:]}.\n")
+    out.append(f"```text\n{_usage(name, sub)}\n```\n")
+    rows = sorted((a for a in sub._actions if not isinstance(a, argparse._HelpAction)),
+                  key=lambda a: bool(a.option_strings))
+    out.append("| argument | meaning |\n|---|---|")
+    out += [f"| `{_cell(_invocation(a))}` | {_details(a)} |" for a in rows]
+    for g in sub._mutually_exclusive_groups:
+        names = " and ".join(f"`{a.option_strings[0]}`" for a in g._group_actions)
+        out.append(f"\n{names} exclude each other{' (give one)' if g.required else ''}.")
+    if example:
+        out.append(f"\nExample:\n\n```bash\n{example}\n```\n")
+    return out
+
+
 def render() -> str:
     """The Markdown text of the reference."""
     parser = build_parser()
@@ -89,20 +113,9 @@ def render() -> str:
     out += [f"| [`amble {n}`](#amble-{n}) | {_cell(s.description or '')} |" for n, s in subs.items()]
     out.append("\n`amble --version` prints the version; `amble COMMAND --help` prints a command's options.\n")
     for name, sub in subs.items():
-        out.append(f"## amble {name}\n")
-        desc = sub.description or ""
-        out.append(f"{desc[:1].upper()}{desc[1:]}.\n")
-        out.append(f"```text\n{_usage(name, sub)}\n```\n")
-        rows = sorted((a for a in sub._actions if not isinstance(a, argparse._HelpAction)),
-                      key=lambda a: bool(a.option_strings))
-        out.append("| argument | meaning |\n|---|---|")
-        out += [f"| `{_cell(_invocation(a))}` | {_details(a)} |" for a in rows]
-        groups = [g for g in sub._mutually_exclusive_groups]
-        for g in groups:
-            names = " and ".join(f"`{a.option_strings[0]}`" for a in g._group_actions)
-            out.append(f"\n{names} exclude each other.")
-        if name in EXAMPLES:
-            out.append(f"\nExample:\n\n```bash\n{EXAMPLES[name]}\n```\n")
+        out += _section(name, sub, "##", EXAMPLES.get(name))
+        for action, child in _subcommands(sub).items():  # a command's actions (amble cache list)
+            out += _section(f"{name} {action}", child, "###", _epilog_example(child))
     return "\n".join(out).rstrip() + "\n"
 
 

@@ -21,6 +21,7 @@ from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
+from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
 from .output import write_output
 
@@ -219,6 +220,7 @@ EXAMPLES = {
     "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
     "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
     "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
+    "cache": "amble cache clear --older-than 30 --dry-run",
 }
 
 
@@ -342,6 +344,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
 
     add_gait_parser(add, model_arg)
+    add_cache_parser(add)
     return p
 
 
