@@ -246,7 +246,8 @@ def building(contents: Contents, now: float | None = None) -> list[Entry]:
 def info(d: Path | None = None) -> dict[str, Any]:
     """The cache directory, whether amble can use it, its entries counted by kind, its total size
     (bytes, amble's files and any others), the builds in progress, and the toolchain a build
-    would use now: compiler command, the first line of its ``--version``, ``$AMBLE_CFLAGS``."""
+    would use now: compiler command, the first line of its ``--version``, the flags it would pass
+    (:func:`amble.backend.cache.cflags`)."""
     if d is None:
         why, d = _why_unusable()
     else:

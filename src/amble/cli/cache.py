@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from typing import Any
 
 from .args import UsageError, _float
@@ -68,7 +69,8 @@ def cmd_info(args: argparse.Namespace) -> dict[str, Any]:
                  ("model libraries", out["models"]), ("runtime objects", out["runtimes"]),
                  ("index entries", out["index_entries"]), ("builds in progress", out["builds_in_progress"]),
                  ("total size", f"{size(out['bytes'])} ({out['bytes']} bytes)"), ("compiler", said),
-                 ("flags", " ".join(out["cflags"]) + "  ($AMBLE_CFLAGS)")]
+                 ("flags", " ".join(out["cflags"]) + ("  ($AMBLE_CFLAGS)" if "AMBLE_CFLAGS" in os.environ
+                                                       else "  (default: code for this processor)"))]
         for k, v in lines:
             print(f"{k + ':':<20}{v}")
     return out
