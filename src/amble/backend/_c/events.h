@@ -127,6 +127,10 @@ static int sample_times(double h, int ntr, int nsub, const double *g_old, const 
         double a0 = g_old[k], a1 = h * gd0[k], b0 = g_new[k], b1 = h * gd1[k];
         /* cubic c(θ) = a0 + a1 θ + c2 θ² + c3 θ³ matching values and slopes */
         double c2 = 3 * (b0 - a0) - 2 * a1 - b1, c3 = 2 * (a0 - b0) + a1 + b1;
+        /* c'(θ) = a1 + 2 c2 θ + 3 c3 θ² has the Bernstein coefficients a1, a1 + c2, b1 on [0, 1]:
+         * all of one sign, c is monotone in the step and has no extremum to sample (most steps) */
+        const double m1 = a1 + c2;
+        if ((a1 > 0.0 && m1 > 0.0 && b1 > 0.0) || (a1 < 0.0 && m1 < 0.0 && b1 < 0.0)) continue;
         double A = 3 * c3, B = 2 * c2, C = a1;
         double r[2];
         int nr = 0;
