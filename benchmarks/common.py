@@ -134,6 +134,12 @@ def machine() -> dict[str, str]:
         cc = subprocess.run(["cc", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     except (OSError, IndexError):
         pass
+    try:
+        from amble.backend.cache import cflags
+
+        flags = " ".join(cflags())
+    except Exception as e:  # noqa: BLE001 - a machine table must not fail the run
+        flags = f"unknown ({e})"
     return {
         "CPU": cpu,
         "cores (os.cpu_count)": str(os.cpu_count()),
@@ -142,6 +148,7 @@ def machine() -> dict[str, str]:
         "load average at start (1, 5, 15 min)": load,
         "OS": f"{platform.system()} {platform.release()} ({platform.machine()})",
         "C compiler": cc,
+        "C flags of amble's libraries": flags,
         "Python": platform.python_version(),
         "NumPy": _version("numpy"),
         "SymPy": _version("sympy"),
