@@ -15,6 +15,7 @@ import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -200,10 +201,11 @@ def _arrays(rows: list[dict[str, str]], shape: tuple[int, int]) -> tuple[np.ndar
     else:
         at = np.array([int(r["i"]) for r in rows]) * shape[1] + np.array([int(r["j"]) for r in rows])
     label = {lab: c for c, lab in enumerate(BASIN_LABELS)}
-    outcome.ravel()[at] = [label[r["outcome"]] for r in rows]
-    st.ravel()[at] = list(map(int, [r["steps"] for r in rows]))
-    dist.ravel()[at] = [float(d) if d else math.nan for d in [r["distance"] for r in rows]]
-    why.ravel()[at] = [r["reason"] for r in rows]
+    codes, done, far, reasons = zip(*map(itemgetter("outcome", "steps", "distance", "reason"), rows))
+    outcome.ravel()[at] = list(map(label.__getitem__, codes))
+    st.ravel()[at] = list(map(int, done))
+    dist.ravel()[at] = [float(d) if d else math.nan for d in far]
+    why.ravel()[at] = reasons
     return outcome, st, dist, why
 
 
@@ -249,6 +251,8 @@ def basin(
     grid of one task, its walks share them; on Dask, each task's walks share this many threads of
     its worker. Two threads on two cores walk a map in about half the time; the result does not
     depend on it (each cell is walked whole by one thread; the compacted file is sorted by key).
+    The fixed point and the section are found once per system and parameters in a process
+    (:mod:`amble.analysis.basin_setup`): another map of the same gait starts walking at once.
     """
     k, pvec, snames = compiled(system, params)
     for nm in x_names:
@@ -280,10 +284,11 @@ def basin(
     per_task = 1 if side_by_side else threads
 
     def shrinking(left: int) -> int:
-        # side by side, tasks shrink as the grid runs out (at most rows_per_task rows, about a
-        # 2·threads-th of the rows left): rows differ in cost, and a large task started last leaves
-        # the other threads idle at the end (a 12-row grid cut 5 + 5 + 2 ran as 7 + 5 rows)
-        return min(rows_per_task, -(-left // (2 * threads)))
+        # side by side, tasks shrink as the grid runs out (at most rows_per_task rows, a
+        # (threads + 1)-th of the rows left): rows differ in cost, and a large task started last
+        # leaves the other threads idle at the end; smaller still, each task's own set-up (~0.1 ms)
+        # costs more than the balance gains (12 rows on 2 threads: 4 + 3 + 2 + 1 + 1 + 1)
+        return min(rows_per_task, -(-left // (threads + 1)))
 
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
