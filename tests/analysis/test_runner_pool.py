@@ -57,3 +57,28 @@ def test_a_sweep_started_inside_a_task_gets_its_own_pool():
     done.join(timeout=30)
     assert not done.is_alive(), "a sweep inside a task waited on the threads running it"
     assert sorted(store.rows) == [5, 15]
+
+
+def test_two_basins_at_once_share_the_pool_and_equal_one_at_a_time(compass):
+    import numpy as np
+
+    from amble.analysis.basin import basin
+
+    kw = dict(steps=15, rows_per_task=1, threads=2, scheduler="synchronous", progress=False)
+    grids = [(("stance", "stance_dot"), ((-0.35, -0.10), (0.8, 1.4)), (6, 3)),
+             (("stance", "stance_dot"), ((-0.30, -0.15), (0.9, 1.2)), (5, 4))]
+    alone = [basin(compass, *g, **kw) for g in grids]
+    together: list = [None, None]
+
+    def one(i: int) -> None:
+        together[i] = basin(compass, *grids[i], **kw)
+
+    workers = [threading.Thread(target=one, args=(i,)) for i in range(2)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join(timeout=60)
+    for a, b in zip(alone, together):
+        assert b is not None
+        for name in ("outcome", "steps", "distance", "reasons"):
+            np.testing.assert_array_equal(getattr(b, name), getattr(a, name))

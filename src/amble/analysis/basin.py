@@ -24,7 +24,7 @@ from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import ConvergenceError, StateError
 from ..simulation.engine import Options, walk_many
-from .basin_setup import fixed_point, section_spec
+from .basin_setup import setup
 from .cells import TextRows, fmt_floats, fmt_ints
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
@@ -269,11 +269,10 @@ def basin(
     sweep_values(av, x_names[0]), sweep_values(bv, x_names[1])
     # the fixed point and the section depend on the system and parameters only: a second map of
     # the same gait in this process reuses them (:mod:`amble.analysis.basin_setup`)
-    xs = fixed_point(system, params, pvec)
+    xs, section = setup(system, params, pvec, x_names, snames, rtol, atol, section=to_state is None)
     base = xs if base_state is None else np.asarray(base_state, float)
     if base.shape != xs.shape:
         raise StateError(f"base_state needs {xs.size} values ({', '.join(snames)})")
-    section = None if to_state is not None else section_spec(system, params, pvec, xs, x_names, snames, rtol, atol)
     # the cells' keys (as :func:`point_key` writes them), each column's text made once
     ti, tj, ta, tb = fmt_ints(range(len(av))), fmt_ints(range(len(bv))), fmt_floats(av), fmt_floats(bv)
     keys = [[(ti[i], tj[j], ta[i], tb[j]) for j in range(len(bv))] for i in range(len(av))]

@@ -72,32 +72,28 @@ def _system_key(system: HybridSystem) -> tuple:
     return (_floats(system.fixed_point_guess), starts, float(system.max_step_time))
 
 
-def fixed_point(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.ndarray) -> np.ndarray:
+def setup(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.ndarray, x_names: Sequence[str],
+          snames: Sequence[str], rtol: float, atol: float, *, section: bool = True
+          ) -> tuple[np.ndarray, SectionSpec | None]:
     """The period-1 fixed point of :func:`amble.analysis.poincare.find_fixed_point` at ``params``
-    (``pvec``: their parameter vector), from the table when the same search ran before; a new
-    array on every call."""
-    from .poincare import find_fixed_point
+    (``pvec``: their parameter vector; a new array on every call) and, with ``section``, the
+    post-impact section through its image (integrator tolerances ``rtol``, ``atol``) charted by the
+    coordinates ``x_names`` first (of the state names ``snames``): :class:`StateError` when the
+    two are tied on it. Each from the table when the same inputs were seen before."""
+    from .poincare import ReturnMap, find_fixed_point
 
     k = build(system, derivatives=True)
-    key = ("fixed point", id(system), id(k), np.asarray(pvec, float).tobytes(), bool(params), _system_key(system))
-    xs = _SETUPS.get(key, (system, k))
+    owners, base = (system, k), (id(system), id(k), np.asarray(pvec, float).tobytes(), _system_key(system))
+    key = ("fixed point", *base, bool(params))
+    xs = _SETUPS.get(key, owners)
     if xs is None:
         xs = np.array(find_fixed_point(system, params=params).fixed_point, float)
         xs.flags.writeable = False
-        _SETUPS.put(key, (system, k), xs)
-    return xs.copy()
-
-
-def section_spec(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.ndarray, xs: np.ndarray,
-                 x_names: Sequence[str], snames: Sequence[str], rtol: float, atol: float) -> SectionSpec:
-    """The post-impact section through the image of ``xs`` (at integrator tolerances ``rtol``,
-    ``atol``) charted by ``x_names`` first; :class:`StateError` when the two are tied on it."""
-    from .poincare import ReturnMap
-
-    k = build(system, derivatives=True)
-    key = ("section", id(system), id(k), np.asarray(pvec, float).tobytes(), np.asarray(xs, float).tobytes(),
-           tuple(x_names), float(rtol), float(atol), _system_key(system))
-    spec = _SETUPS.get(key, (system, k))
+        _SETUPS.put(key, owners, xs)
+    if not section:
+        return xs.copy(), None
+    key = ("section", *base, xs.tobytes(), tuple(x_names), float(rtol), float(atol))
+    spec = _SETUPS.get(key, owners)
     if spec is None:
         sec = Section.of(ReturnMap(system, params, rtol=rtol, atol=atol), xs)
         try:
@@ -107,8 +103,8 @@ def section_spec(system: HybridSystem, params: Mapping[str, float] | None, pvec:
             raise StateError(f"basin: {x_names[0]} and {x_names[1]} are tied on the section (they cannot both be "
                              f"varied); section coordinates of this model: {free}") from None
         spec = (sec.tr, sec.t, tuple(sec.pre.tolist()), tuple(S.tolist()))
-        _SETUPS.put(key, (system, k), spec)
-    return spec[0], spec[1], list(spec[2]), list(spec[3])
+        _SETUPS.put(key, owners, spec)
+    return xs.copy(), (spec[0], spec[1], list(spec[2]), list(spec[3]))
 
 
-__all__ = ["SectionSpec", "fixed_point", "section_spec"]
+__all__ = ["SectionSpec", "setup"]
