@@ -15,6 +15,7 @@ import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -23,10 +24,11 @@ from ..backend.abi import CODE
 from ..backend.kernels import build
 from ..errors import ConvergenceError, StateError
 from ..simulation.engine import Options, walk_many
+from .basin_setup import setup
 from .cells import TextRows, fmt_floats, fmt_ints
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
-from .section import Section
+from .section import PROJECT_TOL, Section
 from .sweep_runner import compiled, run_sweep
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
@@ -89,6 +91,23 @@ def _embed(k: Any, p: np.ndarray, section: tuple | None, idx: Sequence[int], S: 
     return to_state
 
 
+def _on_section(sec: Section, raw: np.ndarray, S: Sequence[int], threads: int) -> tuple[np.ndarray, np.ndarray]:
+    """The states :meth:`Section.project_many` gives for the rows of ``raw``, as one array (rows of
+    NaN where no state of the section has a row's coordinates), and the mask of those rows: the
+    same compiled iteration and fallback, without a Python object and a copy per cell."""
+    n = raw.shape[1]
+    y, ok = sec.k.project_batch(sec.source, sec.tr, sec.row, sec.t, sec.pre, np.asarray(S, int), raw, sec.p,
+                                PROJECT_TOL, 30, threads)
+    x0 = y[:, :n].copy()
+    off = np.zeros(len(raw), dtype=bool)
+    for r in np.flatnonzero(~ok).tolist():  # rows the compiled iteration could not decide: the full one
+        try:
+            x0[r] = sec.project(raw[r], S)
+        except ConvergenceError:
+            x0[r], off[r] = np.nan, True
+    return x0, off
+
+
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
                 base: list[float], fixed: list[float], to_state: Callable | None, steps: int, check_every: int,
                 tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None,
@@ -119,10 +138,9 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
         idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
         raw = np.tile(b0, (m, 1))
         raw[:, idx[0]], raw[:, idx[1]] = aa, bb
-        on = Section(k, p, *section[:3]).project_many(raw, section[3], threads=threads)
-        for c in [c for c, x in enumerate(on) if x is None]:  # no state of the section has these coordinates
+        x0, off = _on_section(Section(k, p, *section[:3]), raw, section[3], threads)
+        for c in np.flatnonzero(off).tolist():  # no state of the section has these coordinates
             why[c] = "off the section"
-        x0 = np.array([x0[0] if x is None else x for x in on])  # one pass in C (x0[0]: a row of NaN)
         # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite
         bad = ~np.isfinite(x0.sum(axis=1))
     else:
@@ -169,6 +187,28 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     return TextRows(zip(*(cols[c] for c in basin_columns(x_names))))
 
 
+def _arrays(rows: list[dict[str, str]], shape: tuple[int, int]) -> tuple[np.ndarray, ...]:
+    """Outcome codes, footfalls, distances and reasons on the grid from the stored rows (in key
+    order: row by row), column by column; cells without a row are −1, 0, NaN and ``""``."""
+    outcome = np.full(shape, -1, dtype=int)
+    st = np.zeros(shape, dtype=int)
+    dist = np.full(shape, math.nan)
+    why = np.full(shape, "", dtype=object)
+    if not rows:
+        return outcome, st, dist, why
+    if len(rows) == outcome.size:  # the whole grid, row by row: no indices to read
+        at: Any = np.s_[:]
+    else:
+        at = np.array([int(r["i"]) for r in rows]) * shape[1] + np.array([int(r["j"]) for r in rows])
+    label = {lab: c for c, lab in enumerate(BASIN_LABELS)}
+    codes, done, far, reasons = zip(*map(itemgetter("outcome", "steps", "distance", "reason"), rows))
+    outcome.ravel()[at] = list(map(label.__getitem__, codes))
+    st.ravel()[at] = list(map(int, done))
+    dist.ravel()[at] = [float(d) if d else math.nan for d in far]
+    why.ravel()[at] = reasons
+    return outcome, st, dist, why
+
+
 def basin(
     system: HybridSystem,
     x_names: tuple[str, str],
@@ -211,9 +251,9 @@ def basin(
     grid of one task, its walks share them; on Dask, each task's walks share this many threads of
     its worker. Two threads on two cores walk a map in about half the time; the result does not
     depend on it (each cell is walked whole by one thread; the compacted file is sorted by key).
+    The fixed point and the section are found once per system and parameters in a process
+    (:mod:`amble.analysis.basin_setup`): another map of the same gait starts walking at once.
     """
-    from .poincare import ReturnMap, find_fixed_point
-
     k, pvec, snames = compiled(system, params)
     for nm in x_names:
         if nm not in snames:
@@ -227,21 +267,12 @@ def basin(
     av = np.linspace(ranges[0][0], ranges[0][1], int(n[0]))
     bv = np.linspace(ranges[1][0], ranges[1][1], int(n[1]))
     sweep_values(av, x_names[0]), sweep_values(bv, x_names[1])
-    lc = find_fixed_point(system, params=params)
-    xs = lc.fixed_point
+    # the fixed point and the section depend on the system and parameters only: a second map of
+    # the same gait in this process reuses them (:mod:`amble.analysis.basin_setup`)
+    xs, section = setup(system, params, pvec, x_names, snames, rtol, atol, section=to_state is None)
     base = xs if base_state is None else np.asarray(base_state, float)
     if base.shape != xs.shape:
         raise StateError(f"base_state needs {xs.size} values ({', '.join(snames)})")
-    section = None
-    if to_state is None:
-        sec = Section.of(ReturnMap(system, params, rtol=rtol, atol=atol), xs)
-        try:
-            S = sec.coordinates(prefer=[snames.index(nm) for nm in x_names])
-        except StateError:
-            free = ", ".join(snames[i] for i in sec.coordinates())
-            raise StateError(f"basin: {x_names[0]} and {x_names[1]} are tied on the section (they cannot both be "
-                             f"varied); section coordinates of this model: {free}") from None
-        section = (sec.tr, sec.t, sec.pre.tolist(), S.tolist())
     # the cells' keys (as :func:`point_key` writes them), each column's text made once
     ti, tj, ta, tb = fmt_ints(range(len(av))), fmt_ints(range(len(bv))), fmt_floats(av), fmt_floats(bv)
     keys = [[(ti[i], tj[j], ta[i], tb[j]) for j in range(len(bv))] for i in range(len(av))]
@@ -251,25 +282,23 @@ def basin(
     side_by_side = scheduler == "synchronous" and threads > 1 and len(av) > rows_per_task
     per_task = 1 if side_by_side else threads
 
+    def shrinking(left: int) -> int:
+        # side by side, tasks shrink as the grid runs out (at most rows_per_task rows, a
+        # (threads + 1)-th of the rows left): rows differ in cost, and a large task started last
+        # leaves the other threads idle at the end; smaller still, each task's own set-up (~0.1 ms)
+        # costs more than the balance gains (12 rows on 2 threads: 4 + 3 + 2 + 1 + 1 + 1)
+        return min(rows_per_task, -(-left // (threads + 1)))
+
     def make_task(rows: list[int], grp: Sequence[int], store: Any) -> tuple:
         return (system, pvec.tolist(), [(i, float(av[i])) for i in rows], bv.tolist(), base.tolist(), xs.tolist(),
                 to_state, steps, check_every, tol, rtol, atol, list(x_names), section, per_task)
 
     res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
-                    groups=[list(range(len(av)))], split=rows_per_task, make_task=make_task, fn=_basin_task, out=out,
-                    scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
-                    params=list(x_names), state_names=snames, threads=threads if side_by_side else 1)
-    outcome = np.full((len(av), len(bv)), -1, dtype=int)
-    st = np.zeros((len(av), len(bv)), dtype=int)
-    dist = np.full((len(av), len(bv)), math.nan)
-    why = np.full((len(av), len(bv)), "", dtype=object)
-    if res.rows:  # column by column: one pass over the rows for each
-        at = (np.array([int(r["i"]) for r in res.rows]), np.array([int(r["j"]) for r in res.rows]))
-        label = {lab: c for c, lab in enumerate(BASIN_LABELS)}
-        outcome[at] = [label[r["outcome"]] for r in res.rows]
-        st[at] = [int(r["steps"]) for r in res.rows]
-        dist[at] = [float(r["distance"]) if r["distance"] else math.nan for r in res.rows]
-        why[at] = [r["reason"] for r in res.rows]
+                    groups=[list(range(len(av)))], split=shrinking if side_by_side else rows_per_task,
+                    make_task=make_task, fn=_basin_task, out=out, scheduler=scheduler, workers=workers,
+                    progress=progress, max_points=max_points, params=list(x_names), state_names=snames,
+                    threads=threads if side_by_side else 1, ordered=True)  # keys listed row by row: key order
+    outcome, st, dist, why = _arrays(res.rows, (len(av), len(bv)))
     return BasinResult(names=tuple(x_names), a_values=av, b_values=bv, outcome=outcome, steps=st, distance=dist,
                        fixed_point=xs, path=str(out) if out else None, computed=res.computed,
                        state_names=snames, reasons=why)

@@ -327,8 +327,7 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
             raise ConvergenceError(f"damped Newton stalled at residual {res:.3g} after {it} iterations")
     else:
         raise ConvergenceError(f"no convergence in {max_iter} iterations (residual {res:.3g})")
-    xs = y
-    Px, T = P(xs)
+    xs, Px = y, Py  # the map of the converged state: the last iterate's (the run would repeat it bit for bit)
     _refuse_rest(system, P, xs, T)
     lower = _lower_period(P, xs, period, tol)
     if lower:

@@ -11,6 +11,7 @@ result file (:class:`~amble.analysis.store.ResultStore`), as each task's rows la
 from __future__ import annotations
 
 import os
+import threading
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -177,7 +178,10 @@ def _pooled(fn: Callable, tasks: list[tuple], store: ResultStore, bar: Any, thre
     from concurrent.futures import ThreadPoolExecutor, as_completed
 
     error: BaseException | None = None
-    pool = ThreadPoolExecutor(min(threads, len(tasks)), thread_name_prefix="amble-sweep")
+    # a sweep run from a task of another (a user's embedding that maps a basin) gets a pool of its
+    # own: waiting on the shared pool's threads from one of them could wait for ever
+    own = threading.current_thread().name.startswith(_POOL_PREFIX)
+    pool = ThreadPoolExecutor(threads, thread_name_prefix=_POOL_PREFIX) if own else _pool(threads)
     futures = [pool.submit(fn, *t) for t in tasks]
     pending = set(futures)
     while pending:
@@ -199,9 +203,39 @@ def _pooled(fn: Callable, tasks: list[tuple], store: ResultStore, bar: Any, thre
                     f.cancel()
             elif isinstance(e, KeyboardInterrupt):  # interrupted again while finishing: stop waiting
                 break
-    pool.shutdown(wait=not isinstance(error, KeyboardInterrupt), cancel_futures=True)
+    if own:
+        pool.shutdown(wait=not isinstance(error, KeyboardInterrupt), cancel_futures=True)
+    elif not isinstance(error, KeyboardInterrupt):  # the shared pool stays: wait for this call's running tasks
+        for fut in futures:
+            if not fut.cancelled():
+                fut.exception()
     if error is not None:
         raise error
+
+
+#: Thread pools of :func:`_pooled` by size, with the process they were made in: starting and
+#: joining the threads of a new pool on every call cost over half a millisecond, about a tenth of
+#: walking a 12 × 12 basin map. At most :data:`_POOL_SIZES` sizes are kept (the oldest is shut down).
+_POOLS: dict[int, tuple[int, Any]] = {}
+_POOL_SIZES = 4
+_POOL_PREFIX = "amble-sweep"
+_POOLS_LOCK = threading.Lock()
+
+
+def _pool(threads: int) -> Any:
+    """This process's pool of ``threads`` threads (a pool made before a ``fork`` has no threads
+    in the child: it is replaced)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with _POOLS_LOCK:
+        hit = _POOLS.get(threads)
+        if hit is not None and hit[0] == os.getpid():
+            return hit[1]
+        if len(_POOLS) >= _POOL_SIZES:
+            _POOLS.pop(next(iter(_POOLS)))[1].shutdown(wait=False)
+        pool = ThreadPoolExecutor(threads, thread_name_prefix=_POOL_PREFIX)
+        _POOLS[threads] = (os.getpid(), pool)
+        return pool
 
 
 # ---------------------------------------------------------------------------- grid helpers

@@ -62,36 +62,44 @@ def seed_before(store: ResultStore, keys: Sequence[Sequence[Key]], group: Sequen
 def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys: Sequence[Sequence[Key]],
               groups: Sequence[Sequence[int]], make_task: Callable[[list[int], Sequence[int], ResultStore], tuple],
               fn: Callable[..., list[dict[str, Any]]], out: str | os.PathLike | None, scheduler: Any,
-              workers: int | None, progress: bool, max_points: int | None, split: int | None = None,
-              params: Sequence[str] = (), state_names: Sequence[str] = (), threads: int = 1) -> SweepResult:
+              workers: int | None, progress: bool, max_points: int | None,
+              split: int | Callable[[int], int] | None = None,
+              params: Sequence[str] = (), state_names: Sequence[str] = (), threads: int = 1,
+              ordered: bool = False) -> SweepResult:
     """Run the pending points of a sweep and return every stored row of its grid, sorted by key.
 
     ``columns``: column name → type (:data:`amble.analysis.store.COLUMN_TYPES`), in file order;
     ``key``: the key columns; ``keys[g]``: the keys of point ``g`` (it is pending while one is
     missing); ``groups``: the chunks of point indices. The pending points of a group, cut to the
-    budget (``max_points`` keys) and into runs of ``split`` points (default: all), become the
+    budget (``max_points`` keys) and into runs of ``split`` points (default: all; a callable:
+    ``split(n)`` points for the next task while ``n`` points are left to schedule), become the
     task ``make_task(points, group, store)``, run as ``fn(*task)``. ``computed`` / ``reused``
     of the result count keys. ``threads``: with ``scheduler='synchronous'``, tasks run this many
     at a time on threads of this process (:func:`amble.analysis.runner.execute`); the journal's
-    rows are then in the order tasks finish, the compacted file sorted as always.
+    rows are then in the order tasks finish, the compacted file sorted as always. ``ordered``:
+    the keys, point by point, are already in key order (a grid listed row by row), so the rows are
+    taken in that order instead of sorted (the same rows, in the same order).
     """
     # the column types let the store ignore a damaged row instead of counting it ok
     with ResultStore(out, dict(columns), key) as store:  # holds the file's lock until the end
         flat = [kk for ks in keys for kk in ks]
-        store.check_keys(flat)
+        fresh = not store.rows  # nothing stored yet (no file, or a new one): every point is pending
+        if not fresh:
+            store.check_keys(flat)
         per = max(1, max((len(ks) for ks in keys), default=1))  # keys per point (a basin row: its cells)
-        missing = sum(1 for kk in flat if not store.has(kk))
-        pending_points = sum(1 for ks in keys if not all(store.has(kk) for kk in ks))
+        missing = len(flat) if fresh else sum(1 for kk in flat if not store.has(kk))
+        pending = [True] * len(keys) if fresh else [not all(store.has(kk) for kk in ks) for ks in keys]
+        pending_points = sum(pending)
         budget = pending_points if max_points is None else max(0, min(pending_points, int(max_points) // per))
         tasks, n_sched = [], 0
         for grp in groups:
-            pts = [g for g in grp if not all(store.has(kk) for kk in keys[g])]
-            step = split or max(1, len(pts))
-            for run in (pts[i:i + step] for i in range(0, len(pts), step)):
-                if n_sched >= budget:
-                    break
-                run = run[: budget - n_sched]
+            pts = [g for g in grp if pending[g]]
+            at = 0
+            while at < len(pts) and n_sched < budget:
+                step = split(budget - n_sched) if callable(split) else split or len(pts)
+                run = pts[at:at + max(1, step)][: budget - n_sched]
                 tasks.append(make_task(run, grp, store))
+                at += len(run)
                 n_sched += len(run)
         computed = n_sched * per
         client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
@@ -99,11 +107,17 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
             execute(client, fn, tasks, store, progress, computed, kind, threads=threads)
         finally:
             close()
-        complete = all(store.has(kk) for kk in flat)
-        rows = store.sorted_rows()  # sorted once, for the file and the result
+        if ordered:  # one pass over the grid: its rows, in key order
+            rows = [r for r in map(store.rows.get, flat) if r is not None]
+            inside = len(rows)
+        else:
+            rows = store.sorted_rows()  # sorted once, for the file and the result
+            inside = sum(1 for kk in flat if kk in store.rows)
+        complete = inside == len(flat)
         if complete:
-            store.compact(rows)
-        if sum(1 for kk in flat if kk in store.rows) != len(store.rows):  # rows outside the grid: left out
+            # the file keeps every stored row: ``rows`` are all of them unless some lie outside the grid
+            store.compact(rows if inside == len(store.rows) else store.sorted_rows())
+        if not ordered and inside != len(store.rows):  # rows outside the grid: left out
             wanted = set(flat)
             rows = [r for r in rows if tuple(r[c] for c in key) in wanted]
         return SweepResult(kind=kind, params=list(params), rows=rows, path=str(out) if out else None, complete=complete,
