@@ -107,4 +107,10 @@ def setup(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.nda
     return xs.copy(), (spec[0], spec[1], list(spec[2]), list(spec[3]))
 
 
-__all__ = ["SectionSpec", "setup"]
+def forget() -> None:
+    """Empty the table: the next basin of every system works its set-up out again (a first call's
+    cost, as benchmarks measure it; or the memory back)."""
+    _SETUPS.clear()
+
+
+__all__ = ["SectionSpec", "forget", "setup"]
