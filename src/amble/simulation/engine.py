@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import threading
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -295,6 +295,7 @@ _FIRST_EVENTS = 256
 _FREE = threading.local()
 
 
+@lru_cache(maxsize=64)  # asked on every recording run, with the same few shapes
 def _first_rows(nxm: int, budget: int) -> int:
     """Sample rows to start with: :data:`_FIRST_ROWS`, or fewer if a small budget asks for it."""
     row = 8 + 4 + 8 * nxm
@@ -313,6 +314,9 @@ class _Buffers:
         self.epost = np.zeros((max(ecap, 1), nxm))
         self.n = np.zeros(1, dtype=np.int64)
         self.ne = np.zeros(1, dtype=np.int64)
+        # the row and event counters as Python ints: a memoryview reads and writes them without
+        # making a NumPy scalar (several of which a short run's fixed cost was made of)
+        self._counts = (memoryview(self.n), memoryview(self.ne))
         self._addresses = self.addresses()
         self._shape = (cap, ecap, nxm)
 
@@ -324,7 +328,8 @@ class _Buffers:
         buf = free.pop((cap, _FIRST_EVENTS, nxm), None) if free else None
         if buf is None:
             return cls(cap, _FIRST_EVENTS, nxm)
-        buf.n[0] = buf.ne[0] = 0
+        n, ne = buf._counts
+        n[0] = ne[0] = 0
         return buf
 
     def addresses(self) -> tuple[int, ...]:
@@ -365,7 +370,7 @@ class _Buffers:
         never grew."""
         if self is _NO_RECORDING:
             return _EMPTY
-        n, ne = int(self.n[0]), int(self.ne[0])
+        n, ne = self._counts[0][0], self._counts[1][0]
         out = {"t": self.t[:n].copy(), "mode": self.mode[:n].copy(), "x": self.x[:n].copy(),
                "et": self.et[:ne].copy(), "etr": self.etr[:ne].copy(), "epre": self.epre[:ne].copy(),
                "epost": self.epost[:ne].copy()}

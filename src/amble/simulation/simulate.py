@@ -183,17 +183,15 @@ def simulate(
     steps = _count(steps, "steps", base.max_events)
     t_end = None if t_end is None else _real(t_end, "t_end (end time, s)")
     sample_dt = _real(sample_dt, "sample_dt (s)")
-    rtol = base.rtol if rtol is None else _real(rtol, "rtol")
-    atol = base.atol if atol is None else _real(atol, "atol")
+    # tolerances taken from ``base`` were checked when it was made (Options.__post_init__)
+    rtol = base.rtol if rtol is None else _tolerance(rtol, "rtol")
+    atol = base.atol if atol is None else _tolerance(atol, "atol")
     max_step_time = None if max_step_time is None else _real(max_step_time, "max_step_time (s)")
     budget = _count(budget, "budget (bytes)", 0) or RECORD_BUDGET
     if t_end is not None and not (t_end > 0 and math.isfinite(t_end)):
         raise StateError(f"end time must be positive and finite, got {t_end}")
     if not (sample_dt >= 0 and math.isfinite(sample_dt)):
         raise StateError(f"sample_dt must be a finite number ≥ 0 s, got {sample_dt}")
-    for name, v in (("rtol", rtol), ("atol", atol)):
-        if not (v > 0 and math.isfinite(v)):
-            raise StateError(f"{name} must be a positive number, got {v}")
     implicit = (method or (options.method if options else "dop853")) == "radau"
     k = build(system, derivatives=implicit)  # the implicit integrator's Newton matrix is the exact Jacobian
     p = parameter_vector(k, params, system)
@@ -228,6 +226,14 @@ def _real(value: Any, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise StateError(f"{what} must be a number, got {value!r}")
     return float(value)
+
+
+def _tolerance(value: Any, name: str) -> float:
+    """A given tolerance as a positive, finite float, else :class:`StateError`."""
+    v = _real(value, name)
+    if not (v > 0 and math.isfinite(v)):
+        raise StateError(f"{name} must be a positive number, got {v}")
+    return v
 
 
 def _count(value: Any, what: str, most: int) -> int | None:
@@ -277,9 +283,9 @@ def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
     # never needed)
     events: Sequence[Event] = (Events(rec["et"], rec["etr"], rec["epre"], rec["epost"], _kinds(meta), k.nx_max)
                                if len(rec.get("et", ())) else [])
-    return Trajectory(t=rec["t"], mode=rec["mode"], x=rec["x"], events=events, status=r.status,
-                      message=_message(r, opts, trs, meta.get("switches", [])), steps=r.steps, params=p,
-                      kernels=k, final_state=r.x, final_mode=meta["modes"][r.mode])
+    # positional: the dataclass's keyword parsing was a fifth of this function's cost
+    return Trajectory(rec["t"], rec["mode"], rec["x"], events, r.status,
+                      _message(r, opts, trs, meta.get("switches", ())), r.steps, p, k, r.x, meta["modes"][r.mode])
 
 
 #: Per transition list (by its id): its names and the state lengths on either side, as
@@ -320,11 +326,6 @@ _MESSAGES = {
 }
 
 
-#: Status name by code, and the fields each message template reads (parsed once).
-_NAMES = {c: n for n, c in CODE.items()}
-_FIELDS = {name: {f for _, f, _, _ in string.Formatter().parse(text) if f} for name, text in _MESSAGES.items()}
-
-
 #: How each message field is worked out from (run, options, transitions, switching surfaces).
 _FIELD_VALUES = {
     "t": lambda r, o, trs, sw: r.t, "steps": lambda r, o, trs, sw: r.steps, "events": lambda r, o, trs, sw: r.events,
@@ -338,12 +339,22 @@ _FIELD_VALUES = {
 }
 
 
-def _message(r: Run, opts: Options, trs: list, switches: list) -> str:
-    name = _NAMES.get(r.code, "")
-    template = _MESSAGES.get(name, "stopped at t = {t:.6g} s")
+#: By status code: its message template and the fields the template reads (parsed once).
+_TEMPLATES = {code: (text, tuple(dict.fromkeys(f for _, f, _, _ in string.Formatter().parse(text) if f)))
+              for code, text in ((CODE[name], text) for name, text in _MESSAGES.items() if name in CODE)}
+_OTHER = ("stopped at t = {t:.6g} s", ("t",))
+#: The most common ending, formatted without the per-field look-ups (its template, written out).
+_STEPS_DONE = CODE["STEPS_DONE"]
+assert _MESSAGES["STEPS_DONE"] == "{steps} steps in {t:.6g} s", "keep _message's written-out template in step"
+
+
+def _message(r: Run, opts: Options, trs: Sequence, switches: Sequence) -> str:
+    if r.code == _STEPS_DONE:
+        return f"{r.steps} steps in {r.t:.6g} s"
+    template, fields = _TEMPLATES.get(r.code, _OTHER)
     # only the fields this template reads are worked out (the state as a list, the stiffness
     # hint: microseconds on every call of simulate() otherwise)
-    return template.format(**{f: _FIELD_VALUES[f](r, opts, trs, switches) for f in _FIELDS.get(name, ("t",))})
+    return template.format_map({f: _FIELD_VALUES[f](r, opts, trs, switches) for f in fields})
 
 
 def _stiff_hint(r: Run, opts: Options) -> str:
