@@ -3,7 +3,7 @@
 Both depend only on the system, its parameters and (for the section) the integrator tolerances
 and the two grid coordinates, never on the grid: a map redrawn at another resolution, or another
 box of the same gait, needs the same ones. They are worked out once per such inputs in a process
-and kept in a small table (:class:`_Memo`): the fixed-point search and the section's chart cost
+and kept in a small table (:class:`amble.simulation.memo.Memo`): the fixed-point search and the section's chart cost
 about as much as walking a 12 × 12 map, and they run before any cell can start, on one thread.
 
 The table is keyed by the values the search reads — the parameter vector, whether parameters
@@ -24,6 +24,7 @@ import numpy as np
 
 from ..backend.kernels import build
 from ..errors import StateError
+from ..simulation.memo import Memo
 from .section import Section
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
@@ -34,32 +35,8 @@ if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, with
 SectionSpec = tuple[int, float, list[float], list[int]]
 
 
-class _Memo:
-    """Results keyed by a tuple of values, each stored with the objects it belongs to; a hit
-    needs those very objects (``is``), and the table is emptied at ``limit`` entries: a sweep
-    over parameters makes a new key per call."""
-
-    def __init__(self, limit: int) -> None:
-        self._table: dict[tuple, tuple[tuple, Any]] = {}
-        self._limit = limit
-
-    def get(self, key: tuple, owners: tuple) -> Any:
-        hit = self._table.get(key)
-        if hit is None or len(hit[0]) != len(owners) or any(a is not b for a, b in zip(hit[0], owners)):
-            return None
-        return hit[1]
-
-    def put(self, key: tuple, owners: tuple, value: Any) -> None:
-        if len(self._table) >= self._limit:
-            self._table.clear()
-        self._table[key] = (owners, value)
-
-    def clear(self) -> None:
-        self._table.clear()
-
-
 #: Fixed points and sections of recent basins in this process.
-_SETUPS = _Memo(16)
+_SETUPS = Memo(16)
 
 
 def _floats(v: Any) -> tuple[float, ...] | None:
@@ -85,15 +62,15 @@ def setup(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.nda
     k = build(system, derivatives=True)
     owners, base = (system, k), (id(system), id(k), np.asarray(pvec, float).tobytes(), _system_key(system))
     key = ("fixed point", *base, bool(params))
-    xs = _SETUPS.get(key, owners)
+    xs = _SETUPS.get(key, *owners)
     if xs is None:
         xs = np.array(find_fixed_point(system, params=params).fixed_point, float)
         xs.flags.writeable = False
-        _SETUPS.put(key, owners, xs)
+        _SETUPS.put(key, xs, *owners)
     if not section:
         return xs.copy(), None
     key = ("section", *base, xs.tobytes(), tuple(x_names), float(rtol), float(atol))
-    spec = _SETUPS.get(key, owners)
+    spec = _SETUPS.get(key, *owners)
     if spec is None:
         sec = Section.of(ReturnMap(system, params, rtol=rtol, atol=atol), xs)
         try:
@@ -103,7 +80,7 @@ def setup(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.nda
             raise StateError(f"basin: {x_names[0]} and {x_names[1]} are tied on the section (they cannot both be "
                              f"varied); section coordinates of this model: {free}") from None
         spec = (sec.tr, sec.t, tuple(sec.pre.tolist()), tuple(S.tolist()))
-        _SETUPS.put(key, owners, spec)
+        _SETUPS.put(key, spec, *owners)
     return xs.copy(), (spec[0], spec[1], list(spec[2]), list(spec[3]))
 
 

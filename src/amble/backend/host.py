@@ -33,8 +33,13 @@ _CPU_FIELDS = ("vendor_id", "cpu family", "model", "model name", "flags", "featu
 def flags_setting() -> str:
     """The flags as set (``$AMBLE_CFLAGS`` or the default), and with native code the processor's
     identity: what the cache keys hash. Cheap: no compiler is run."""
-    s = os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS)
-    return f"{s}\0{cpu_identity()}" if "native" in s else s
+    return _setting(os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS))
+
+
+@lru_cache(maxsize=8)
+def _setting(flags: str) -> str:
+    # one string object per setting: the keys' caches hash it once, not a kilobyte per build()
+    return f"{flags}\0{cpu_identity()}" if "native" in flags else flags
 
 
 def cflags(cc: str) -> list[str]:

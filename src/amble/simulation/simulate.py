@@ -20,30 +20,11 @@ from ..backend.abi import CODE, CTX
 from ..backend.kernels import Kernels, build
 from ..errors import ParameterError, StateError
 from .engine import RECORD_BUDGET, Options, Run, run
+from .memo import Memo
 from .trajectory import Event, Events, Trajectory
 
 if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
-
-
-class _Memo:
-    """Values worked out once per call site's inputs, keyed by a tuple that starts with the id of
-    the object they belong to. That object's identity is checked on every hit (an id is reused
-    once its object is gone), and the table is emptied at ``limit`` entries (callers that make a
-    new object or value per call would fill it)."""
-
-    def __init__(self, limit: int) -> None:
-        self._table: dict[tuple, tuple[Any, Any]] = {}
-        self._limit = limit
-
-    def get(self, key: tuple, owner: Any) -> Any:
-        hit = self._table.get(key)
-        return hit[1] if hit is not None and hit[0] is owner else None
-
-    def put(self, key: tuple, owner: Any, value: Any) -> None:
-        if len(self._table) >= self._limit:
-            self._table.clear()
-        self._table[key] = (owner, value)
 
 
 def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: HybridSystem | None = None
@@ -80,7 +61,7 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: Hyb
     if p.size == 0:
         p = np.zeros(1)
     if key is not None:
-        _PARAMETERS.put(key, k, (p, given))
+        _PARAMETERS.put(key, (p, given), k)
         return p.copy()
     return p
 
@@ -88,7 +69,7 @@ def parameter_vector(k: Kernels, params: Mapping[str, float] | None, system: Hyb
 #: Parameter vectors by (id of the kernels, the overrides as given) → (vector, the overrides as
 #: checked against the domains): names, numbers and finiteness are checked once; a sweep passes a
 #: new value on every call, hence the bound.
-_PARAMETERS = _Memo(256)
+_PARAMETERS = Memo(256)
 
 
 def _parameter_key(k: Kernels, params: Any) -> tuple | None:
@@ -259,7 +240,7 @@ def _count(value: Any, what: str, most: int) -> int | None:
 _DEFAULT_OPTIONS = Options()
 
 #: Options by (id(base), rtol, atol, max_step_time, method).
-_OPTIONS = _Memo(64)
+_OPTIONS = Memo(64)
 
 
 def _options(base: Options, rtol: float, atol: float, max_step_time: float, method: str) -> Options:
@@ -271,7 +252,7 @@ def _options(base: Options, rtol: float, atol: float, max_step_time: float, meth
     opts = _OPTIONS.get(key, base)
     if opts is None:
         opts = dataclasses.replace(base, rtol=rtol, atol=atol, max_step_time=max_step_time, method=method)
-        _OPTIONS.put(key, base, opts)
+        _OPTIONS.put(key, opts, base)
     return opts
 
 
@@ -290,7 +271,7 @@ def _trajectory(k: Kernels, p: np.ndarray, r: Run, opts: Options) -> Trajectory:
 
 #: Per transition list (by its id): its names and the state lengths on either side, as
 #: :class:`Events` reads them.
-_KINDS = _Memo(64)
+_KINDS = Memo(64)
 
 
 def _kinds(meta: dict) -> list[tuple[str, str, str, int, int]]:
@@ -300,7 +281,7 @@ def _kinds(meta: dict) -> list[tuple[str, str, str, int, int]]:
         modes, nx = meta["modes"], meta["nx"]
         kinds = [(tr["name"], tr["source"], tr["target"], nx[modes.index(tr["source"])],
                   nx[modes.index(tr["target"])]) for tr in trs]
-        _KINDS.put((id(trs),), trs, kinds)
+        _KINDS.put((id(trs),), kinds, trs)
     return kinds
 
 
