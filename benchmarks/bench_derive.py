@@ -256,7 +256,8 @@ def run(quick: bool = False) -> Section:
         "Cold derive + code generation + C compile of an n-link planar pendulum chain (point masses at "
         "the link ends, absolute angles, all masses/lengths/g as run-time parameters). Each amble run is "
         "a fresh Python process with a fresh `AMBLE_CACHE_DIR`. " + SECTION_NOTE + " *total* = writing the Model + "
-        "`amble.backend.kernels.build` (derive, codegen, compile with the default flags of the machine table, load), imports excluded on both sides. "
+        "`amble.backend.kernels.build` (derive, codegen, compile with the default flags of the machine table, "
+        "load), imports excluded on both sides. "
         + reps_note
         + "SymPy peer: `LagrangesMethod` + `lambdify(cse=True)` in a fresh process per n, one run each, "
         f"stopped at the first n past {peer_limit:.0f} s. Ops: arithmetic operations with common "
