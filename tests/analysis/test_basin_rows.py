@@ -14,6 +14,7 @@ import time
 
 import numpy as np
 import pytest
+from cells import walk_cell
 
 from amble.analysis.basin import BASIN_LABELS, basin
 from amble.analysis.cells import TextRows, fmt_floats, fmt_ints, fmt_value
@@ -22,7 +23,7 @@ from amble.analysis.poincare import find_fixed_point
 from amble.analysis.store import ResultStore
 from amble.backend.kernels import build
 from amble.errors import ConvergenceError, OutputError
-from amble.simulation.engine import Options, run
+from amble.simulation.engine import Options
 
 SYNC = {"scheduler": "synchronous", "progress": False}
 SLOPE = 0.05  # the compass gait's default
@@ -83,22 +84,6 @@ def _on_slope(a: float, b: float, base: np.ndarray) -> np.ndarray:
     return x
 
 
-def _direct(k, p, x, xs, opts, steps, every, tol):
-    """(outcome, reason, footfalls, distance) of a cell walked run by run in Python."""
-    done, dist = 0, math.nan
-    while done < steps:
-        m = min(every, steps - done)
-        r = run(k, p, 0, x, steps=m, opts=opts)
-        x = r.x
-        if not r.completed:
-            return ("fell" if r.status == "fell" else "failed"), r.status, done + r.steps, dist
-        done += m
-        dist = float(np.max(np.abs(x - xs)))
-        if dist < tol:
-            return "converged", "", done, dist
-    return "not converged", "", done, dist
-
-
 def test_basin_cells_written_are_direct_walks(compass, walker, tmp_path):
     k, p, xs = walker
     steps, every, tol = 20, 5, 1e-6
@@ -120,7 +105,7 @@ def test_basin_cells_written_are_direct_walks(compass, walker, tmp_path):
         elif a > -0.12:
             want = ("failed", "invalid initial state", 0, math.nan)
         else:
-            want = _direct(k, p, _on_slope(a, b, xs), xs, opts, steps, every, tol)
+            want = walk_cell(k, p, _on_slope(a, b, xs), xs, opts, steps, every, tol)
         got = (r["outcome"], r["reason"], int(r["steps"]), float(r["distance"]))
         assert got[:3] == want[:3], (i, j)
         assert _bits(got[3]) == _bits(want[3]) or (math.isnan(got[3]) and math.isnan(want[3])), (i, j)

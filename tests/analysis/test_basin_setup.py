@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from cells import walk_cell
 from scipy.optimize import root
 
 import amble.analysis.poincare as poincare
@@ -113,22 +114,6 @@ def test_a_failed_search_is_not_remembered(searches):
     assert searches[0] >= 2
 
 
-def _walk(k, p, x, xs, opts, steps, every, tol):
-    """(outcome, footfalls, distance) of one cell walked run by run with ``engine.run``."""
-    done, dist = 0, math.nan
-    while done < steps:
-        m = min(every, steps - done)
-        r = run(k, p, 0, x, steps=m, opts=opts)
-        x = r.x
-        if not r.completed:
-            return ("fell" if r.status == "fell" else "failed"), done + r.steps, dist
-        done += m
-        dist = float(np.max(np.abs(x - xs)))
-        if dist < tol:
-            return "converged", done, dist
-    return "not converged", done, dist
-
-
 @pytest.mark.parametrize("threads", [1, 2])
 def test_cells_on_the_section_are_direct_walks(compass, threads):
     """The default embedding: a cell's state has the grid's stance angle and rate, the swing rate
@@ -145,7 +130,7 @@ def test_cells_on_the_section_are_direct_walks(compass, threads):
     for i, a in enumerate(av):
         for j, b in enumerate(bv):
             x = np.array([a, 2 * slope - a, b, xs[3]])
-            label, done, dist = _walk(k, p, x, xs, opts, steps, every, tol)
+            label, _, done, dist = walk_cell(k, p, x, xs, opts, steps, every, tol)
             assert (BASIN_LABELS[res.outcome[i, j]], int(res.steps[i, j])) == (label, done), (i, j)
             if math.isnan(dist):
                 assert math.isnan(res.distance[i, j])
