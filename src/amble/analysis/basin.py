@@ -28,7 +28,7 @@ from .basin_setup import setup
 from .cells import TextRows, fmt_floats, fmt_ints
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
-from .section import PROJECT_TOL, Section
+from .section import Section
 from .sweep_runner import compiled, run_sweep
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
@@ -91,23 +91,6 @@ def _embed(k: Any, p: np.ndarray, section: tuple | None, idx: Sequence[int], S: 
     return to_state
 
 
-def _on_section(sec: Section, raw: np.ndarray, S: Sequence[int], threads: int) -> tuple[np.ndarray, np.ndarray]:
-    """The states :meth:`Section.project_many` gives for the rows of ``raw``, as one array (rows of
-    NaN where no state of the section has a row's coordinates), and the mask of those rows: the
-    same compiled iteration and fallback, without a Python object and a copy per cell."""
-    n = raw.shape[1]
-    y, ok = sec.k.project_batch(sec.source, sec.tr, sec.row, sec.t, sec.pre, np.asarray(S, int), raw, sec.p,
-                                PROJECT_TOL, 30, threads)
-    x0 = y[:, :n].copy()
-    off = np.zeros(len(raw), dtype=bool)
-    for r in np.flatnonzero(~ok).tolist():  # rows the compiled iteration could not decide: the full one
-        try:
-            x0[r] = sec.project(raw[r], S)
-        except ConvergenceError:
-            x0[r], off[r] = np.nan, True
-    return x0, off
-
-
 def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, float]], b_values: list[float],
                 base: list[float], fixed: list[float], to_state: Callable | None, steps: int, check_every: int,
                 tol: float, rtol: float, atol: float, x_names: Sequence[str], section: tuple | None = None,
@@ -138,7 +121,7 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
         idx = [list(k.meta["state_names"][k.meta["modes"][mi]]).index(nm) for nm in x_names]
         raw = np.tile(b0, (m, 1))
         raw[:, idx[0]], raw[:, idx[1]] = aa, bb
-        x0, off = _on_section(Section(k, p, *section[:3]), raw, section[3], threads)
+        x0, off = Section(k, p, *section[:3]).project_array(raw, section[3], threads=threads)
         for c in np.flatnonzero(off).tolist():  # no state of the section has these coordinates
             why[c] = "off the section"
         # a NaN or ±inf anywhere (or entries near 1e308) makes the sum non-finite

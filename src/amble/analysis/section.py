@@ -187,22 +187,27 @@ class Section:
         released, rows shared by ``threads`` threads); ``None`` for a row with no state of Σ
         (where :meth:`project` raises :class:`ConvergenceError`). A row the compiled iteration
         cannot decide (a rank-deficient step, a failing reset) is projected by :meth:`project`."""
+        y, off = self.project_array(x, S, tol=tol, max_iter=max_iter, threads=threads)
+        return [None if off[r] else y[r].copy() for r in range(len(y))]
+
+    def project_array(self, x: np.ndarray, S: Sequence[int], *, tol: float = PROJECT_TOL, max_iter: int = 30,
+                      threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`project_many` as one array, rows of NaN where a row has no state of Σ, and the
+        mask of those rows: no Python object per row (the cells of a basin map)."""
         x = np.asarray(x, float)
         n = self.k.meta["nx"][self.target]
         if x.ndim != 2 or x.shape[1] != n:
             raise StateError(f"project: states of the section's mode have {n} values, got shape {x.shape}")
         y, ok = self.k.project_batch(self.source, self.tr, self.row, self.t, self.pre, np.asarray(S, int), x, self.p,
                                      tol, max_iter, threads)
-        out: list[np.ndarray | None] = []
-        for r in range(len(x)):
-            if ok[r]:
-                out.append(y[r, :n].copy())
-                continue
+        out = y[:, :n].copy()
+        off = np.zeros(len(x), dtype=bool)
+        for r in np.flatnonzero(~ok).tolist():  # rows the compiled iteration could not decide: the full one
             try:
-                out.append(self.project(x[r], S, tol=tol, max_iter=max_iter))
+                out[r] = self.project(x[r], S, tol=tol, max_iter=max_iter)
             except ConvergenceError:
-                out.append(None)
-        return out
+                out[r], off[r] = np.nan, True
+        return out, off
 
 
 __all__ = ["PROJECT_TOL", "RANK_TOL", "Section", "chart"]
