@@ -129,7 +129,8 @@ def _why_unusable() -> tuple[str | None, Path]:
     return cache._unusable(d), d
 
 
-def _stat(p: Path) -> os.stat_result | None:
+def lstat(p: Path) -> os.stat_result | None:
+    """The status of ``p`` itself (a link's, not its target's), ``None`` if it is gone."""
     try:
         return p.lstat()  # a link is the link's own business: never followed out of the cache
     except OSError:  # removed meanwhile (another process cleared or rebuilt)
@@ -162,8 +163,8 @@ def scan(d: Path | None = None) -> Contents:
     for (kind, key), files in groups.items():
         meta = read_record(d / (f"runtime-{key}.json" if kind == "runtime" else f"{key}.json"))
         main = d / str(meta.get("object" if kind == "runtime" else "library", "")) if meta else None
-        use = _stat(main) if main is not None and main in files else None
-        stats = [s for s in map(_stat, files) if s is not None]
+        use = lstat(main) if main is not None and main in files else None
+        stats = [s for s in map(lstat, files) if s is not None]
         last = max(use.st_atime, use.st_mtime) if use else max((s.st_mtime for s in stats), default=0.0)
         size = sum(s.st_size for s in stats)
         if kind == "runtime":
@@ -181,7 +182,7 @@ def scan(d: Path | None = None) -> Contents:
 
 def _single(kind: str, p: Path) -> Entry:
     """An entry of one file, or of a build directory (its size: that of the files in it)."""
-    st = _stat(p)
+    st = lstat(p)
     size = st.st_size if st else 0
     if p.is_dir() and not p.is_symlink():
         try:
@@ -256,7 +257,7 @@ def info(d: Path | None = None) -> dict[str, Any]:
     if why is not None:
         out["reason"] = why
     c = scan(d) if why is None else Contents(d)
-    other = sum(s.st_size for s in map(_stat, c.other) if s is not None)
+    other = sum(s.st_size for s in map(lstat, c.other) if s is not None)
     out.update(models=len(c.models), runtimes=len(c.runtimes), index_entries=len(c.index), stamps=len(c.stamps),
                builds_in_progress=len(building(c)), other_files=len(c.other),
                bytes=sum(e.bytes for e in c.entries()) + other)

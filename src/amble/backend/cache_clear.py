@@ -104,7 +104,7 @@ def clear(d: Path | None = None, *, everything: bool = False, older_than: float 
     def take(e: Entry, why_kept: Any) -> None:
         gone = []
         for p in sorted(e.files, key=lambda p: p.suffix != ".json"):  # the record first
-            st = _lstat(p)
+            st = admin.lstat(p)
             if st is None:
                 continue  # removed meanwhile
             size = e.bytes if p.is_dir() else st.st_size  # a build directory: the files in it
@@ -168,13 +168,6 @@ def _began(e: Entry) -> float:
     except OSError:
         pass
     return min(times)
-
-
-def _lstat(p: Path) -> os.stat_result | None:
-    try:
-        return p.lstat()
-    except OSError:
-        return None
 
 
 def _remove(p: Path) -> str | None:
