@@ -236,14 +236,10 @@ def _reset_repr(reset: Any) -> list:
     return out
 
 
-def _fingerprint(system: HybridSystem) -> tuple:
-    return (len(system.transitions), *map(id, system.modes.values()))
-
-
 def _structure(system: HybridSystem) -> str:
     """The structural hash, computed once per system object (see the module docstring)."""
     sid = id(system)
-    fp = _fingerprint(system)
+    fp = fingerprint(system)
     hit = _STRUCT.get(sid)
     if hit is not None and hit[0]() is system and hit[1] == fp:
         return hit[2]
@@ -262,8 +258,22 @@ def _forget(sid: int) -> Any:
 
 def structure_key(system: HybridSystem) -> str:
     """Cache key of a system's library: its structure, the generating sources, the toolchain."""
+    cc, flags, path = settings()
+    return _key(_structure(system), cc or "", host.setting_of(flags), path or "")
+
+
+def settings() -> tuple[str | None, str | None, str | None]:
+    """The environment a library's key reads besides the system: ``$CC``, ``$AMBLE_CFLAGS`` and
+    ``$PATH`` (where the compiler is found). Equal settings and an unchanged system
+    (:func:`fingerprint`) give the same key."""
     env = os.environ
-    return _key(_structure(system), env.get("CC") or "", host.flags_setting(), env.get("PATH") or "")
+    return env.get("CC"), env.get("AMBLE_CFLAGS"), env.get("PATH")
+
+
+def fingerprint(system: HybridSystem) -> tuple:
+    """What a system's structural hash is checked against on every use: the number of transitions
+    and the identities of the mode objects (see the module docstring)."""
+    return (len(system.transitions), *map(id, system.modes.values()))
 
 
 @lru_cache(maxsize=256)

@@ -33,7 +33,12 @@ _CPU_FIELDS = ("vendor_id", "cpu family", "model", "model name", "flags", "featu
 def flags_setting() -> str:
     """The flags as set (``$AMBLE_CFLAGS`` or the default), and with native code the processor's
     identity: what the cache keys hash. Cheap: no compiler is run."""
-    return _setting(os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS))
+    return setting_of(os.environ.get("AMBLE_CFLAGS"))
+
+
+def setting_of(flags: str | None) -> str:
+    """:func:`flags_setting` for ``$AMBLE_CFLAGS`` read as ``flags`` (``None``: not set)."""
+    return _setting(DEFAULT_CFLAGS if flags is None else flags)
 
 
 @lru_cache(maxsize=8)

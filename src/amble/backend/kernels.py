@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import ctypes
 import threading
+import weakref
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -50,6 +51,30 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
         if k is not None:
             return k
         system = system.full()
+    served = (id(system), derivatives, cache.fingerprint(system), *cache.settings())
+    hit = _SERVED.get(served)
+    if hit is not None and hit[0]() is system:
+        return hit[1]
+    k = _load(system, derivatives)
+    if len(_SERVED) >= 256:  # systems made per call (a sweep over models) would fill it
+        _SERVED.clear()
+    entry = (weakref.ref(system), k)  # an id reused by a later system finds a dead reference
+    _SERVED[served] = entry
+    if k.meta.get("derivatives"):  # from now on it serves plain runs too, as _load prefers it
+        _SERVED[(served[0], not derivatives, *served[2:])] = entry
+    return k
+
+
+#: What :func:`build` served, by (id of the system, derivatives asked, its
+#: :func:`~amble.backend.cache.fingerprint`, the :func:`~amble.backend.cache.settings` its key
+#: reads) → (weak reference to the system, kernels): working out the key and the defaults again
+#: took longer than the rest of a short :func:`~amble.simulation.simulate.simulate` call's
+#: checks together. Weak: a served system is not kept alive by this table.
+_SERVED: dict[tuple, tuple[weakref.ref, Kernels]] = {}
+
+
+def _load(system: HybridSystem, derivatives: bool) -> Kernels:
+    """The kernels of ``system``, without the table of served ones (see :func:`build`)."""
     plain = cache.structure_key(system)
     full = cache.derivatives_key(plain)
     k = _LOADED.get(full) or (None if derivatives else _LOADED.get(plain))

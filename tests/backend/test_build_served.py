@@ -1,0 +1,59 @@
+"""build() serves a system the kernels it was served before, and notices what changes the library."""
+
+import gc
+import weakref
+
+from amble import Guard, HybridSystem, Model
+from amble.backend import kernels
+
+
+def _dropping_mass(name: str) -> HybridSystem:
+    m = Model(name)
+    x, z = m.coordinates("x z")
+    mass, g = m.parameters(mass=1.0, g=9.81)
+    m.point("p", (x, z), mass=mass)
+    m.gravity(g)
+    system = HybridSystem(name, m)
+    system.terminal("landed", name, Guard(z + 1), status="landed")
+    return system
+
+
+def test_the_same_system_is_served_the_same_kernels():
+    s = _dropping_mass("served-again")
+    assert kernels.build(s) is kernels.build(s)
+
+
+def test_a_transition_added_after_a_build_gets_a_new_library():
+    s = _dropping_mass("served-grown")
+    before = kernels.build(s)
+    assert before.n_tr == 1
+    s.terminal("far", "served-grown", Guard(s.modes["served-grown"].q[0] - 5), status="far")
+    after = kernels.build(s)
+    assert after.n_tr == 2 and after.path != before.path
+
+
+def test_plain_builds_get_the_derivative_kernels_once_they_exist():
+    s = _dropping_mass("served-derivatives")
+    plain = kernels.build(s)
+    assert not plain.meta.get("derivatives")
+    full = kernels.build(s, derivatives=True)
+    assert full.meta["derivatives"] and full is not plain
+    assert kernels.build(s) is full  # as a fresh process that finds both libraries would serve
+
+
+def test_a_changed_compiler_setting_is_seen(monkeypatch):
+    s = _dropping_mass("served-flags")
+    native = kernels.build(s)
+    monkeypatch.setenv("AMBLE_CFLAGS", "-O1")
+    assert kernels.build(s).path != native.path
+    monkeypatch.delenv("AMBLE_CFLAGS")
+    assert kernels.build(s) is native
+
+
+def test_serving_keeps_no_system_alive():
+    s = _dropping_mass("served-dropped")
+    kernels.build(s)
+    ref = weakref.ref(s)
+    del s
+    gc.collect()
+    assert ref() is None
