@@ -197,7 +197,7 @@ def test_a_half_written_file_marks_a_build_until_it_is_a_killed_ones(cache_copy,
     kept = {p.name for p, _ in r.kept}
     assert {tmp.name, fresh_a.name} <= kept and any(n.startswith("runtime-") for n in kept)
     assert tmp.exists() and fresh_a.exists() and cache.cached(d, keys["pend-b", False]) is None
-    _age([tmp], 2 * cache._ORPHAN_AGE)  # now a killed build's, as the cache's own rule says
+    _age([tmp], 2 * cache.ORPHAN_AGE)  # now a killed build's, as the cache's own rule says
     r = cache_clear.clear(d, everything=True)
     assert not tmp.exists() and not list(d.glob("runtime-*")) and tmp.name in {e.key for e in r.removed}
 
@@ -210,7 +210,7 @@ def test_a_library_not_yet_recorded_is_kept_while_young(cache_copy):
     r = cache_clear.clear(d, older_than=0)
     assert stray.exists() and stray.name in {p.name for p, _ in r.kept}
     assert [e.recorded for e in cache_admin.scan(d).models] == [False]
-    _age([stray], 2 * cache._ORPHAN_AGE)
+    _age([stray], 2 * cache.ORPHAN_AGE)
     cache_clear.clear(d, older_than=0)
     assert not stray.exists()
 

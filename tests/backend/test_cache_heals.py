@@ -79,7 +79,7 @@ def test_builds_a_killed_compile_left_are_removed(tmp_path, monkeypatch):
     for d in (old, fresh):
         d.mkdir()
         (d / "model.c").write_text("/* half written */")
-    past = time.time() - 2 * cache._ORPHAN_AGE
+    past = time.time() - 2 * cache.ORPHAN_AGE
     os.utime(old, (past, past))
     s = _pendulum("orphans")
     cache.rebuild(s, kernels.structure_key(s))

@@ -81,13 +81,29 @@ _SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/*.py")
 _STRUCT: dict[int, tuple[weakref.ref, tuple, str]] = {}
 
 
-#: build directories older than this (s) belong to a compile that was killed
-_ORPHAN_AGE = 3600.0
+#: Build directories and temporary files (:func:`is_temporary`) older than this (s) belong to a
+#: compile that was killed; younger ones may be a build in progress.
+ORPHAN_AGE = 3600.0
 _FALLBACK: dict[str, Path] = {}
 
 
 class CacheWarning(UserWarning):
     """The configured cache directory cannot be used; a private temporary one is used instead."""
+
+
+def is_temporary(name: str) -> bool:
+    """Whether a file name in the cache is a build's working directory or a file being written."""
+    return name.startswith("build-") or (name.startswith(".") and name.endswith(".tmp"))
+
+
+def configured() -> tuple[Path, str | None]:
+    """The configured cache directory and why it cannot be used (``None`` if it can; it is
+    created private if missing)."""
+    try:
+        d = _configured_dir()
+    except RuntimeError as e:  # Path.home() without a home
+        return Path("~"), f"no home directory ({e})"
+    return d, _unusable(d)
 
 
 def _configured_dir() -> Path:
@@ -119,11 +135,7 @@ def _unusable(d: Path) -> str | None:
 def cache_dir() -> Path:
     """The cache directory: the configured one if it is usable (see the module docstring), else a
     private temporary directory for this process (with a :class:`CacheWarning`)."""
-    try:
-        d = _configured_dir()
-        why = _unusable(d)
-    except RuntimeError as e:  # Path.home() without a home
-        d, why = Path("~"), f"no home directory ({e})"
+    d, why = configured()
     if why is None:
         return d
     key = str(d)
@@ -332,9 +344,13 @@ def _remove_orphans(d: Path) -> None:
     import shutil
 
     now = time.time()
-    for p in list(d.glob("build-*")) + list(d.glob(".*.tmp")):
+    try:
+        names = os.listdir(d)
+    except OSError:
+        return
+    for p in [d / n for n in names if is_temporary(n)]:
         try:
-            if now - p.stat().st_mtime > _ORPHAN_AGE:
+            if now - p.stat().st_mtime > ORPHAN_AGE:
                 shutil.rmtree(p) if p.is_dir() else p.unlink()
         except OSError:
             pass

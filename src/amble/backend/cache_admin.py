@@ -15,8 +15,9 @@ The cache directory (:mod:`amble.backend.cache`) holds
 
 Builds take no lock: several processes may build into one directory, each writing under temporary
 names and renaming into place, and a temporary older than the cache's orphan age is a killed
-build's (the rule of ``cache._remove_orphans``). The same marks tell this module that a build is
-in progress, and removal (:mod:`amble.backend.cache_clear`) keeps what a build may be using.
+build's (:func:`amble.backend.cache.is_temporary`, :data:`~amble.backend.cache.ORPHAN_AGE`). The
+same marks tell this module that a build is in progress, and removal
+(:mod:`amble.backend.cache_clear`) keeps what a build may be using.
 
 A library's *last use* is the later of its access and modification times: loading a library reads
 its bytes (their SHA-256 is checked), which the file system records as an access — at most once a
@@ -112,21 +113,11 @@ def directory() -> Path:
     """The cache directory amble compiles into; :class:`CacheRequestError` if the configured one
     cannot be used (amble then compiles into a temporary directory per process, with a warning,
     and there is no cache to see or clear)."""
-    why, d = _why_unusable()
+    d, why = cache.configured()
     if why is not None:
         raise CacheRequestError(f"the cache {d} is not usable ({why}): amble compiles into a temporary "
                                 "directory per process instead")
     return d
-
-
-def _why_unusable() -> tuple[str | None, Path]:
-    """Why the configured cache cannot be used (``None`` if it can), and the directory, found with
-    :mod:`amble.backend.cache`'s own rules."""
-    try:
-        d = cache._configured_dir()
-    except RuntimeError as e:  # Path.home() without a home
-        return f"no home directory ({e})", Path("~")
-    return cache._unusable(d), d
 
 
 def lstat(p: Path) -> os.stat_result | None:
@@ -148,7 +139,7 @@ def scan(d: Path | None = None) -> Contents:
         return out
     for n in names:
         p = d / n
-        if n.startswith("build-") or (n.startswith(".") and n.endswith(".tmp")):  # cache._remove_orphans'
+        if cache.is_temporary(n):
             out.temporaries.append(_single("temporary", p))
         elif m := _RUNTIME.fullmatch(n):
             groups.setdefault(("runtime", m[1]), []).append(p)
@@ -241,7 +232,7 @@ def _specs(index: list[Entry]) -> dict[str, list[str]]:
 def building(contents: Contents, now: float | None = None) -> list[Entry]:
     """The temporaries of builds in progress: those younger than the cache's orphan age."""
     now = time.time() if now is None else now
-    return [e for e in contents.temporaries if now - e.last_used <= cache._ORPHAN_AGE]
+    return [e for e in contents.temporaries if now - e.last_used <= cache.ORPHAN_AGE]
 
 
 def info(d: Path | None = None) -> dict[str, Any]:
@@ -249,10 +240,7 @@ def info(d: Path | None = None) -> dict[str, Any]:
     (bytes, amble's files and any others), the builds in progress, and the toolchain a build
     would use now: compiler command, the first line of its ``--version``, the flags it would pass
     (:func:`amble.backend.cache.cflags`)."""
-    if d is None:
-        why, d = _why_unusable()
-    else:
-        why = None
+    d, why = cache.configured() if d is None else (d, None)
     out: dict[str, Any] = {"directory": str(d), "usable": why is None}
     if why is not None:
         out["reason"] = why

@@ -128,7 +128,7 @@ def clear(d: Path | None = None, *, everything: bool = False, older_than: float 
         named = admin.recorded_files(e)
         take(e, lambda p, st, named=named: in_use(p, st) or (
             "a build in progress renamed it into place and has not recorded it yet"
-            if p not in named and start - st.st_mtime <= cache._ORPHAN_AGE else None))
+            if p not in named and start - st.st_mtime <= cache.ORPHAN_AGE else None))
     # a model build that began meanwhile would link one
     linking = bool(marks) or bool(runtimes and admin.building(admin.scan(d)))
     for e in runtimes:
@@ -148,7 +148,7 @@ def clear(d: Path | None = None, *, everything: bool = False, older_than: float 
         if fresh and everything:
             out.kept.append((e.files[0], "a build in progress"))
         elif not fresh:  # a killed build's, unless written again since the scan
-            take(e, lambda p, st: "a build in progress" if start - st.st_mtime <= cache._ORPHAN_AGE else None)
+            take(e, lambda p, st: "a build in progress" if start - st.st_mtime <= cache.ORPHAN_AGE else None)
     return out
 
 
