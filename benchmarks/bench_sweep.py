@@ -167,8 +167,8 @@ def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
     held = {name: _gil_share(k, fn) for name, (fn, _) in paths.items() if "threads=" in name}
     # a basin's set-up (fixed point, section, result store) is serial whatever the grid: measured
     # alone as a 1 × 1 map, it splits the serial time into set-up and per cell
-    setup = _gil_share(k, lambda w: bas(1, w))
-    setup_kept = _gil_share(k, lambda w: bas(1, w, kept=True))
+    setup = _gil_share(k, lambda w: bas(1, w), reps=7)
+    setup_kept = _gil_share(k, lambda w: bas(1, w, kept=True), reps=7)
     rows, data, goals = [], {}, []
     for name, (_, cells) in paths.items():
         t1, t2 = statistics.median(times[(name, 1)]), statistics.median(times[(name, 2)])
@@ -229,7 +229,9 @@ def _basin_row(m: int, kept: bool = False) -> str:
 
 def _gil_share(k, fn, reps: int = 3) -> tuple[float, float, float]:
     """Share of a one-thread call of ``fn`` spent outside the compiled batch calls (CPU time of
-    this thread, least of ``reps``): the part that holds the GIL; those seconds and the call's."""
+    this thread): the part that holds the GIL; those seconds and the call's. Of ``reps`` calls,
+    the one with the least time outside (the serial part is what this estimates; the least is
+    the one least inflated by the machine, and set-up and map are then compared alike)."""
     from amble.backend.kernels import build
     from amble.models import load
 
@@ -247,14 +249,14 @@ def _gil_share(k, fn, reps: int = 3) -> tuple[float, float, float]:
                 inside[0] += time.thread_time() - t0
             setattr(kk, name, timed)
     try:
-        best = (1.0, math.inf, math.inf)
+        best = (math.inf, 1.0, math.inf)
         for _ in range(reps):
             inside[0] = 0.0
             t0 = time.thread_time()
             fn(1)
             total = time.thread_time() - t0
-            best = min(best, ((total - inside[0]) / total if total > 0 else 1.0, total - inside[0], total))
-        return best
+            best = min(best, (total - inside[0], (total - inside[0]) / total if total > 0 else 1.0, total))
+        return best[1], best[0], best[2]
     finally:
         for kk, name, raw in saved:
             setattr(kk, name, raw)
