@@ -208,6 +208,7 @@ def humanoid(quick: bool) -> tuple[str, list[Goal]]:
     from amble.models import load
     from amble.simulation.engine import Options, run
     from amble.simulation.simulate import initial_state, parameter_vector
+    from benchmarks.peers import compass_scipy, floor
 
     system = load("humanoid-3d")
     k = build(system)
@@ -215,8 +216,6 @@ def humanoid(quick: bool) -> tuple[str, list[Goal]]:
     mi, x = initial_state(system, k, None, None)
     opts = Options(max_step_time=system.max_step_time)
     steps = 3 if quick else 10
-    from benchmarks.peers import compass_scipy, floor
-
     r = run(k, p, mi, x, steps=steps, opts=opts)  # warm-up, and how far it walks
     n = max(r.steps, 1)
     floor.simulate(compass_scipy.LIMIT_CYCLE_X0, 200, 1e-10, 1e-10)  # compile + warm-up
