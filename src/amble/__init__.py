@@ -20,7 +20,8 @@ from .version import __version__  # noqa: F401  (amble.__version__)
 _WHERE: dict[str, str] = {
     **dict.fromkeys(("Equations", "derive"), ".derivation.equations"),
     **dict.fromkeys(("contact_force", "unilateral_contact"), ".derivation.resting"),
-    **dict.fromkeys(("AmbleError", "CompileError", "ConvergenceError", "ModelError", "OutputError", "ParameterError",
+    **dict.fromkeys(("AmbleError", "CompileError", "ConvergenceError", "ExpressionError", "ModelError", "OutputError",
+                     "ParameterError",
                      "SchedulerError", "SimulationError", "StateError"), ".errors"),
     **dict.fromkeys(("RoundFoot", "rolling_centre", "round_foot"), ".modelling.contact"),
     **dict.fromkeys(("NONNEGATIVE", "POSITIVE", "Domain", "interval"), ".modelling.domain"),
@@ -28,6 +29,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("Explicit", "Guard", "HybridSystem", "Impact", "Lock"), ".modelling.hybrid"),
     "Model": ".modelling.model",
     "sample_and_hold": ".modelling.sampled",
+    "parse": ".modelling.text",
     **dict.fromkeys(("base_relabel", "stance_feet_walker"), ".modelling.stance_feet"),
     "Joint": ".modelling.tree",
     **dict.fromkeys(("Walker", "distance_along_slope", "heel_strike", "height_above_slope", "joint_lock", "walker"),

@@ -47,3 +47,10 @@ class SchedulerError(AmbleError, ConnectionError):
 class SolverError(AmbleError, RuntimeError):
     """A numerical optimisation did not succeed (infeasible, restoration failed, iteration limit);
     the message names the reason and the most violated constraint."""
+
+
+class ExpressionError(ModelError, ParameterError):
+    """Text that is not an expression amble reads (an unknown name, a construct outside the
+    whitelist of :mod:`amble.modelling.text`, a syntax error). It is a :class:`ModelError` when the
+    text came with a model and a :class:`ParameterError` when it came as an option, so code that
+    catches either keeps working."""

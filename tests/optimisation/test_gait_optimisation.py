@@ -166,8 +166,6 @@ def test_hzd_gait_walks_in_closed_loop_under_its_virtual_constraints():
     walked by the library's HZD controller with the exported Bézier α: the closed-loop step stays
     within 1e-4 of the collocated one, and Newton on the closed-loop return map (refinement)
     converges next to the optimised fixed point with residual ≤ 1e-8."""
-    import sympy as sp
-
     s = actuated_compass(ankle=False)
     g = optimize_gait(s, params={"slope": SLOPE}, speed=0.8, nodes=[20, 60], bezier_degree=6, hzd=True)
     bz = g.bezier
@@ -176,9 +174,8 @@ def test_hzd_gait_walks_in_closed_loop_under_its_virtual_constraints():
     m = loop.modes["compass-gait"]
     st, sw = m.q
     m.actuator("hip", on=sw - st)
-    names = {str(x): x for x in [*m.q, *m.params]}
-    m.virtual_constraints([sp.sympify(o, locals=names) for o in bz["outputs"]],
-                          sp.sympify(bz["phase"]["expression"], locals=names), bz["alpha"],
+    m.virtual_constraints([m.parse(o) for o in bz["outputs"]],
+                          m.parse(bz["phase"]["expression"]), bz["alpha"],
                           (bz["phase"]["theta_plus"], bz["phase"]["theta_minus"]), epsilon=0.005)
     tr = simulate(loop, g.fixed_point, params={"slope": SLOPE}, steps=1, sample_dt=0.005)
     ev = tr.step_events[0]

@@ -42,6 +42,7 @@ import sympy as sp
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
 from ..errors import ParameterError, SolverError, StateError
 from ..modelling.hybrid import HybridSystem
+from ..modelling.text import expr_of
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
 from .gait_result import Gait, bezier_fit, constraint_report
@@ -346,13 +347,7 @@ def _integrand(model: Any, objective: Any) -> sp.Expr:
 def _expression(model: Any, text: Any, what: str, extra: Sequence[sp.Symbol] = (), hint: str = "") -> sp.Expr:
     """A user expression (text or sympy) in the coordinates, parameters and ``extra`` symbols."""
     known = {str(s): s for s in [*model.q, *model.params, *extra]}
-    if isinstance(text, str):
-        try:
-            expr = sp.sympify(text, locals=known)
-        except (sp.SympifyError, SyntaxError, TypeError) as e:
-            raise ParameterError(f"{what} {text!r} is not an expression ({e})") from None
-    else:
-        expr = sp.sympify(text)
+    expr = expr_of(text, known, what=what)  # text is read, never evaluated
     bad = sorted(str(s) for s in expr.free_symbols if str(s) not in known or known[str(s)] != s)
     if bad:
         raise ParameterError(f"{what} {text!s} uses {', '.join(bad)}: not among the allowed names "

@@ -130,11 +130,7 @@ class ResultStore:
             self._warn_ignored()
             return
         data = self.journal.read_bytes()
-        good = data[: data.rfind(b"\n") + 1]  # a torn last line (killed mid-write) is dropped ...
-        if len(good) < len(data):  # ... and cut off, so the next append starts on a fresh line
-            with open(self.journal, "r+b") as f:
-                f.truncate(len(good))
-                os.fsync(f.fileno())
+        good = data[: data.rfind(b"\n") + 1]  # a torn last line (killed mid-write) is dropped
         try:
             text = good.decode()
         except UnicodeDecodeError as e:  # not written by a sweep (which writes UTF-8): never guess
@@ -147,6 +143,10 @@ class ResultStore:
         if header != self.columns:
             raise OutputError(f"{str(self.journal)!r} holds a different kind of sweep (columns differ); "
                              "use another file")
+        if len(good) < len(data):  # only now, the file known to be this sweep's: cut the torn line
+            with open(self.journal, "r+b") as f:  # off, so the next append starts on a fresh line
+                f.truncate(len(good))
+                os.fsync(f.fileno())
         for n, fields in enumerate(reader, start=2):
             if len(fields) == len(self.columns):
                 self._add_read(dict(zip(self.columns, fields)), f"line {n}")

@@ -29,6 +29,7 @@ from ..errors import ModelError
 from ..modelling.geometry import t
 from ..modelling.hybrid import Explicit, HybridSystem, Transition
 from ..modelling.model import Model
+from ..modelling.text import expr_of
 from .equations import derive
 
 
@@ -80,12 +81,12 @@ def unilateral_contact(system: HybridSystem, name: str, mode: str, gap: Any, res
     model = system.modes[mode]
     if model.tree is not None:
         raise ModelError(f"model {model.name!r}: a unilateral contact on a rigid-body tree is not supported")
-    gap = sp.sympify(gap)
+    gap = expr_of(gap, model.symbol_table(), what=f"model {model.name!r}: contact gap")
     if not (gap.free_symbols & set(model.q)):
         raise ModelError(f"contact {name!r}: the gap {gap} does not depend on the coordinates of mode {mode!r}")
     if gap.free_symbols & set(model.qd):
         raise ModelError(f"contact {name!r}: the gap {gap} must be a function of the coordinates and time only")
-    e = sp.sympify(restitution)
+    e = expr_of(restitution, model.symbol_table(), what=f"contact {name!r}: restitution")
     if e.is_number and not (0 <= float(e) <= 1):
         raise ModelError(f"contact {name!r}: restitution must be in [0, 1], got {e}")
     rest_name = rest_mode or f"{mode}_{name}"

@@ -67,7 +67,7 @@ class Actuators(Names):
         Returns the input's real sympy symbol, named ``name``. ``unit`` defaults to ``N·m`` when
         ``on`` is in radians (every coordinate it uses is) and ``N`` otherwise."""
         self._check_new_name(name, "input")
-        on_e = checked_expr(self.name, on, f"what input {name!r} acts on")
+        on_e = checked_expr(self, on, f"what input {name!r} acts on")
         used = on_e.free_symbols
         coords = [s for s in used if s in self.q]
         bad = sorted(str(s) for s in used - set(self.q) - set(self.params))
@@ -161,7 +161,7 @@ class Actuators(Names):
             if callable(law) and not isinstance(law, sp.Basic):
                 raise ModelError(f"model {self.name!r}: the control law of {k} is a Python callable; give an "
                                  "expression of q, q̇, t and parameters instead")
-            e = checked_expr(self.name, law, f"control law of {k}")
+            e = checked_expr(self, law, f"control law of {k}")
             bad = sorted(str(s) for s in e.free_symbols - allowed)
             if bad:
                 raise ModelError(f"model {self.name!r}: control law of {k} uses {', '.join(bad)}, which "

@@ -10,6 +10,7 @@ import sympy as sp
 from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
+from .text import expr_of
 
 #: Operations sympy keeps unevaluated that compiled code cannot express.
 _UNEVALUATED = (sp.Sum, sp.Product, sp.Integral, sp.Derivative, sp.Limit)
@@ -32,15 +33,17 @@ def _distinct_nodes(e: sp.Basic) -> list[sp.Basic]:
     return out
 
 
-def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
+def checked_expr(model: Any, value: Any, what: str) -> sp.Expr:
     """``value`` as a sympy expression fit for compiled code, or a :class:`ModelError` naming
     ``what``: no unparsable text, no undefined functions, no infinite, undefined or complex
     constants, no unevaluated sums, products, integrals, derivatives or limits (code generation
-    would fail on them far from where they were written)."""
-    try:
-        e = sp.sympify(value)
-    except (sp.SympifyError, TypeError, SyntaxError):
-        raise ModelError(f"model {model!r}: {what} is not an expression: {value!r}") from None
+    would fail on them far from where they were written).
+
+    ``model`` is the model (text is then read in its symbols, :meth:`Names.parse`) or only its
+    name (text is then refused); text is never evaluated (:mod:`amble.modelling.text`)."""
+    table = model.symbol_table() if isinstance(value, str) and hasattr(model, "symbol_table") else None
+    model = getattr(model, "name", model)
+    e = expr_of(value, table, what=f"model {model!r}: {what}")
     if not isinstance(e, sp.Expr):
         raise ModelError(f"model {model!r}: {what} must be an expression, got {value!r}")
     nodes = _distinct_nodes(e)
@@ -56,15 +59,16 @@ def checked_expr(model: str, value: Any, what: str) -> sp.Expr:
     return e
 
 
-def checked_matrix(model: str, value: Any, what: str) -> sp.Matrix:
+def checked_matrix(model: Any, value: Any, what: str) -> sp.Matrix:
     """A column (from a flat sequence) or a matrix (from rows, or a sympy matrix) of :func:`checked_expr`
     entries."""
+    name = getattr(model, "name", model)
     if isinstance(value, sp.MatrixBase):
         rows = value.tolist()
     elif isinstance(value, (list, tuple)):
         rows = [list(r) if isinstance(r, (list, tuple)) else [r] for r in value]
     else:
-        raise ModelError(f"model {model!r}: {what} must be a vector or matrix, got {value!r}")
+        raise ModelError(f"model {name!r}: {what} must be a vector or matrix, got {value!r}")
     if len({len(r) for r in rows}) > 1:
-        raise ModelError(f"model {model!r}: {what} has rows of different lengths")
+        raise ModelError(f"model {name!r}: {what} has rows of different lengths")
     return sp.Matrix([[checked_expr(model, e, what) for e in r] for r in rows])

@@ -11,6 +11,8 @@ from typing import Any
 
 import sympy as sp
 
+from .text import expr_of
+
 #: The time symbol, for explicitly time-dependent forces Γ(q, q̇, t).
 t = sp.Symbol("t", real=True)
 
@@ -54,4 +56,4 @@ def vector(*components: Any) -> sp.Matrix:
     """A column vector from components (numbers or sympy expressions)."""
     if len(components) == 1 and isinstance(components[0], Iterable):
         components = tuple(components[0])
-    return sp.Matrix([sp.sympify(c) for c in components])
+    return sp.Matrix([expr_of(c, what="vector component") for c in components])

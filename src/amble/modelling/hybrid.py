@@ -39,6 +39,7 @@ from .dag import free_symbols
 from .expressions import checked_expr
 from .geometry import t as _TIME
 from .model import Model
+from .text import expr_of, parse
 from .transitions import Explicit, Guard, Impact, Lock, Reset, Transition
 
 __all__ = ["Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Reset", "Transition", "target_exprs"]
@@ -271,15 +272,13 @@ class HybridSystem:
         return dataclasses.replace(guard, expr=expr, direction=int(d), enabled=enabled)
 
 
-def _read(value: Any, names: Mapping[str, sp.Symbol], where: str = "") -> Any:
-    """Text parsed with the mode's own symbols (``"x > 0"`` means the real coordinate ``x``);
-    anything else unchanged. Unparsable text is a :class:`ModelError`."""
+def _read(value: Any, names: Mapping[str, sp.Symbol], where: str = "", condition: bool = False) -> Any:
+    """Text read with the mode's own symbols (``"x > 0"`` means the real coordinate ``x``) by
+    :func:`amble.modelling.text.parse`, which runs nothing; anything else unchanged. Unreadable
+    text is an :class:`~amble.errors.ExpressionError` (a :class:`ModelError`)."""
     if not isinstance(value, str):
         return value
-    try:
-        return sp.sympify(value, locals=dict(names))
-    except (sp.SympifyError, TypeError, SyntaxError) as e:
-        raise ModelError(f"{where}cannot read {value!r} as an expression ({type(e).__name__})") from None
+    return parse(value, names, what=where.rstrip(": ") or "expression", condition=condition)
 
 
 def _condition(system: str, value: Any, names: Mapping[str, sp.Symbol], what: str) -> Any:
@@ -290,10 +289,8 @@ def _condition(system: str, value: Any, names: Mapping[str, sp.Symbol], what: st
     bare symbol or anything else is a :class:`ModelError`."""
     if value is None:
         return None
-    try:
-        e = sp.sympify(_read(value, names, f"system {system!r}: {what}: "))
-    except (sp.SympifyError, TypeError, SyntaxError):
-        raise ModelError(f"system {system!r}: {what} is not a condition: {value!r}") from None
+    # text is read as a condition; a number or Python bool becomes sympy's, refused below if not a comparison
+    e = expr_of(_read(value, names, f"system {system!r}: {what}", condition=True), what=f"system {system!r}: {what}")
     if e is sp.true:
         return None
     if e is sp.false:

@@ -122,7 +122,7 @@ class Model(Actuators):
 
         Returns the position as a column vector so that later points can be built from it.
         """
-        pos = _matrix(self.name, position, f"position of point {name!r}")
+        pos = _matrix(self, position, f"position of point {name!r}")
         if pos.shape != (self.dims, 1):
             raise ModelError(
                 f"model {self.name!r}: point {name!r} has {len(pos)} components, "
@@ -142,7 +142,7 @@ class Model(Actuators):
         """Put a point mass ``m`` (kg) at the named point."""
         if point not in self.points:
             raise ModelError(f"model {self.name!r}: mass placed at unknown point {point!r}")
-        m = _expr(self.name, m, f"mass at {point!r}")
+        m = _expr(self, m, f"mass at {point!r}")
         self._check_symbols(m, f"mass at {point!r}")
         self.masses[point] = self.masses.get(point, sp.Integer(0)) + m
 
@@ -177,8 +177,8 @@ class Model(Actuators):
 
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
-        moment = _expr(self.name, moment, "moment of inertia")
-        self._k_terms.append(sp.Rational(1, 2) * moment * self.dt(_expr(self.name, angle, "inertia angle")) ** 2)
+        moment = _expr(self, moment, "moment of inertia")
+        self._k_terms.append(sp.Rational(1, 2) * moment * self.dt(_expr(self, angle, "inertia angle")) ** 2)
 
     def body_inertia(self, rotation: Any, inertia: Any) -> None:
         """Rotational inertia of a 3D body with orientation ``rotation`` (3×3, body → world).
@@ -187,8 +187,8 @@ class Model(Actuators):
         inertia tensor ``I`` (kg·m², body axes, about the body's centre of mass — whose mass is
         declared with :meth:`point`).
         """
-        Rm = _matrix(self.name, rotation, "body rotation")
-        Im = _matrix(self.name, inertia, "body inertia")
+        Rm = _matrix(self, rotation, "body rotation")
+        Im = _matrix(self, inertia, "body inertia")
         if Rm.shape != (3, 3) or Im.shape != (3, 3):
             raise ModelError(f"model {self.name!r}: body_inertia needs a 3×3 rotation and a 3×3 inertia")
         W = Rm.T * self.dt(Rm)
@@ -198,9 +198,9 @@ class Model(Actuators):
     # ------------------------------------------------------------------ energies
     def gravity(self, g: Any, direction: Any = None) -> None:
         """Uniform gravity of magnitude ``g`` (m/s²) along ``direction`` (default: down, -z)."""
-        self._g = _expr(self.name, g, "gravity")
+        self._g = _expr(self, g, "gravity")
         if direction is not None:
-            d = _matrix(self.name, direction, "gravity direction")
+            d = _matrix(self, direction, "gravity direction")
             if d.shape != (self.dims, 1):
                 raise ModelError(f"model {self.name!r}: gravity direction needs {self.dims} components")
             self._g_dir = d
@@ -208,12 +208,12 @@ class Model(Actuators):
 
     def add_kinetic(self, expr: Any) -> None:
         """Add a kinetic-energy term (J) in q and the velocity symbols."""
-        self._k_terms.append(_expr(self.name, expr, "kinetic energy term"))
+        self._k_terms.append(_expr(self, expr, "kinetic energy term"))
         self._k_added.append(self._k_terms[-1])
 
     def add_potential(self, expr: Any) -> None:
         """Add a potential-energy term (J) in q, e.g. a spring ``k*(q1 - q2)**2/2``."""
-        self._v_terms.append(_expr(self.name, expr, "potential energy term"))
+        self._v_terms.append(_expr(self, expr, "potential energy term"))
 
     @property
     def K(self) -> sp.Expr:
@@ -230,7 +230,7 @@ class Model(Actuators):
 
     @K.setter
     def K(self, expr: Any) -> None:
-        self._k_override = _expr(self.name, expr, "K")
+        self._k_override = _expr(self, expr, "K")
 
     @property
     def V(self) -> sp.Expr:
@@ -249,7 +249,7 @@ class Model(Actuators):
 
     @V.setter
     def V(self, expr: Any) -> None:
-        self._v_override = _expr(self.name, expr, "V")
+        self._v_override = _expr(self, expr, "V")
 
     @property
     def L(self) -> sp.Expr:
@@ -260,7 +260,7 @@ class Model(Actuators):
 
     @L.setter
     def L(self, expr: Any) -> None:
-        self._l_override = _expr(self.name, expr, "L")
+        self._l_override = _expr(self, expr, "L")
 
     @property
     def gravity_vector(self) -> sp.Matrix:
@@ -270,7 +270,7 @@ class Model(Actuators):
     # ------------------------------------------------------------------ forces
     def force(self, generalized: Any) -> None:
         """Add a generalized force vector Γ (one entry per coordinate; may depend on q, q̇, t)."""
-        v = _matrix(self.name, generalized, "generalized force")
+        v = _matrix(self, generalized, "generalized force")
         if v.shape != (len(self.q), 1):
             raise ModelError(
                 f"model {self.name!r}: generalized force needs {len(self.q)} entries, got {len(v)}"
@@ -283,15 +283,15 @@ class Model(Actuators):
         By virtual work its generalized force is ``tau · ∂angle/∂q``: a hip torque between two
         absolute leg angles is ``model.torque(tau, swing - stance)``.
         """
-        angle = _expr(self.name, angle, "torque angle")
-        tau = _expr(self.name, tau, "torque")
+        angle = _expr(self, angle, "torque angle")
+        tau = _expr(self, tau, "torque")
         self._forces.append(sp.Matrix([tau * sp.diff(angle, qi) for qi in self.q]))
 
     def point_force(self, point: str, force: Any) -> None:
         """A force (N, world frame) applied at a named point; Γ = Jᵀ F."""
         if point not in self.points:
             raise ModelError(f"model {self.name!r}: force on unknown point {point!r}")
-        f = _matrix(self.name, force, f"force on point {point!r}")
+        f = _matrix(self, force, f"force on point {point!r}")
         jac = self.jacobian(self.points[point])
         self._forces.append(jac.T * f)
 

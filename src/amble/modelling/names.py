@@ -31,6 +31,21 @@ class Names:
         self.domains: dict[str, Domain] = {}
 
     # ------------------------------------------------------------------ symbols
+    def symbol_table(self) -> dict[str, sp.Symbol]:
+        """Every name of the model and its symbol: coordinates, velocities, parameters, the
+        time ``t`` and (with actuators) the inputs — the names text may use (:meth:`parse`)."""
+        inputs = list(getattr(self, "inputs", []) or [])
+        return {str(s): s for s in [*self.q, *self.qd, *self.params, t, *inputs]}
+
+    def parse(self, text: str, condition: bool = False) -> sp.Basic:
+        """``text`` (e.g. ``"l*sin(q1) - y"``, or with ``condition`` ``"y_dot < 0"``) as a sympy
+        expression in this model's symbols, read by :func:`amble.modelling.text.parse`: nothing
+        in it is executed, an unknown name or construct is an :class:`~amble.errors.ExpressionError`.
+        The way to read expressions that come back as text (JSON results, files, options)."""
+        from .text import parse
+
+        return parse(text, self.symbol_table(), what=f"model {self.name!r}", condition=condition)
+
     def coordinates(self, names: str | Sequence[str], unit: str = "rad") -> tuple[sp.Symbol, ...]:
         """Declare generalized coordinates (in ``unit``, default radians); returns their symbols
         (velocities: :meth:`dot`)."""

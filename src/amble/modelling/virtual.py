@@ -67,8 +67,8 @@ class VirtualConstraints:
 def declare(model: Any, outputs: Sequence[Any], phase: Any, alpha: Any, phase_range: tuple[float, float],
             epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0) -> VirtualConstraints:
     """Declare the virtual constraints on ``model`` (see :meth:`Model.virtual_constraints`)."""
-    outs = [checked_expr(model.name, o, "virtual-constraint output") for o in outputs]
-    ph = checked_expr(model.name, phase, "phase variable")
+    outs = [checked_expr(model, o, "virtual-constraint output") for o in outputs]
+    ph = checked_expr(model, phase, "phase variable")
     if len(outs) != len(model.inputs) or not outs:
         raise ModelError(f"model {model.name!r}: {len(outs)} virtual-constraint output(s) for "
                          f"{len(model.inputs)} input(s); HZD needs one output per input")
