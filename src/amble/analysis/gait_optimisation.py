@@ -31,6 +31,7 @@ with exact sparse first and second derivatives; IPOPT solves it.
 from __future__ import annotations
 
 import os
+import signal
 import sys
 import time
 from collections.abc import Mapping, Sequence
@@ -287,8 +288,10 @@ def optimize_gait(
                          "ipopt.warm_start_bound_push": 1e-8, "ipopt.warm_start_mult_bound_push": 1e-8})
         solver = ca.nlpsol("gait", "ipopt", {"x": w, "f": J, "g": g}, opts)
         t0 = time.perf_counter()
-        with _stdout_to_stderr(progress):
+        with _stdout_to_stderr(progress), _Interrupts() as interrupted:
             sol = solver(x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
+        if interrupted:  # CasADi turns Ctrl-C into a solver failure: it is the user's interrupt
+            raise KeyboardInterrupt
         elapsed = time.perf_counter() - t0
         stats = solver.stats()
         wopt = np.asarray(sol["x"]).ravel()
@@ -406,6 +409,30 @@ def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: 
                 accelerations=A, inputs=U, pre_impact_state=X[-1].copy(), impulse=np.asarray(impulse),
                 extended_velocity=np.asarray(qe), contact_forces=forces,
                 constraints=report, solver=solver, bezier=bezier_fit(model, fns, X, degree, P, alpha))
+
+
+class _Interrupts(list):
+    """Notes a Ctrl-C (SIGINT) during the solve (the list is non-empty afterwards) and raises it as
+    usual. CasADi catches the ``KeyboardInterrupt`` inside IPOPT's iteration and reports a
+    ``NonIpopt_Exception_Thrown`` failure, which would read as a result of the numbers."""
+
+    def __enter__(self) -> _Interrupts:
+        def note(signum: int, frame: Any) -> None:
+            self.append(signum)
+            raise KeyboardInterrupt
+
+        self.saved = None
+        if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+            return self  # a process started to ignore Ctrl-C (a background job) keeps ignoring it
+        try:
+            self.saved = signal.signal(signal.SIGINT, note)
+        except ValueError:  # not the main thread: signals are not delivered here anyway
+            pass
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.saved is not None:
+            signal.signal(signal.SIGINT, self.saved)
 
 
 class _stdout_to_stderr:

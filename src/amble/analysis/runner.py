@@ -69,17 +69,93 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
         except (OSError, TimeoutError, ValueError) as e:
             raise SchedulerError(f"cannot connect to the Dask scheduler at {scheduler!r} ({e})") from None
         return client, client.close
-    n = workers or os.cpu_count() or 1
-    if n < 1:
-        raise StateError(f"workers must be at least 1, got {n}")
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
+    n = workers_for(workers)
+    with _children_ignore_sigint():
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
     client = Client(cluster)
+    client.register_plugin(_quiet_cancels_plugin()())  # sent by value (cloudpickle)
 
     def close() -> None:
-        client.close()
-        cluster.close()
+        import logging
+
+        # an interrupted or failed sweep cancels its running tasks: distributed then logs a warning
+        # and a traceback per task; amble says what happened in one line of its own
+        quiet = logging.getLogger("distributed")
+        level = quiet.level
+        quiet.setLevel(logging.CRITICAL)
+        try:
+            client.close()
+            cluster.close()
+        finally:
+            quiet.setLevel(level)
 
     return client, close
+
+
+def cores() -> int:
+    """The processor cores this process may run on (its affinity, else the machine's count)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):  # no affinity on macOS and Windows
+        return os.cpu_count() or 1
+
+
+def workers_for(workers: int | None) -> int:
+    """The number of local worker processes for ``workers`` (``None``: one per core).
+
+    More processes than cores cannot run a CPU-bound sweep faster; each costs a Python with NumPy
+    and the compiled model (≈ 100 MB) and seconds of start-up, so ``workers=64`` on two cores ran
+    for minutes before the first task. A larger request is capped at the cores, with a warning."""
+    if workers is None:
+        return cores()
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ParameterError(f"workers must be a positive integer, got {workers!r}")
+    if workers > cores():
+        import warnings
+
+        warnings.warn(f"workers={workers} is more than the {cores()} cores this process may use; "
+                      f"running {cores()} worker processes", stacklevel=3)
+        return cores()
+    return workers
+
+
+def _quiet_cancels_plugin() -> type:
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class QuietCancels(WorkerPlugin):
+        """A cancelled task (Ctrl-C, a failed sweep) makes its worker's state machine log a
+        warning with the task's repr: notices of the scheduler's own bookkeeping, not for the
+        user (amble says what happened in one line); the state machine's errors still show."""
+
+        name = "amble-quiet-cancels"
+
+        def setup(self, worker: Any) -> None:
+            import logging
+
+            logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
+
+    return QuietCancels
+
+
+class _children_ignore_sigint:
+    """Worker processes started inside ignore SIGINT (they inherit the disposition, and Python
+    leaves an ignored SIGINT ignored): Ctrl-C in a terminal reaches the whole process group, and
+    only the client should react — it cancels the tasks and closes the cluster — instead of every
+    worker printing its own traceback."""
+
+    def __enter__(self) -> None:
+        import signal
+
+        try:
+            self.saved = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        except ValueError:  # not the main thread
+            self.saved = None
+
+    def __exit__(self, *exc: Any) -> None:
+        import signal
+
+        if self.saved is not None:
+            signal.signal(signal.SIGINT, self.saved)
 
 
 #: Seconds a scheduler address gets to accept a connection and to greet it.
