@@ -88,3 +88,34 @@ def test_no_source_file_is_too_long(suffix):
             if "_vendor" not in p.parts and not p.name.endswith("_tableau.h")
             for n in [len(p.read_text(errors="ignore").splitlines())] if n > MAX_LINES}
     assert long == {}
+
+
+#: Public methods of the declaration classes that only read (properties are reads by nature).
+_READS = {
+    "Names": {"symbol_table", "parse", "domain", "unit", "dot", "symbol"},
+    "Actuators": {"input_unit", "input_matrix", "dynamics"},
+    "Model": {"dt", "diff", "jacobian", "point_jacobian", "point_velocity", "from_urdf", "constrained", "validate"},
+    "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names"},
+    "Walker": {"slope_value", "frame_change"},
+}
+
+
+def test_every_method_of_a_declaration_either_reads_or_counts_its_change():
+    """A built system is found again by its declarations' revisions: a method that changes a
+    declaration without advancing its revision would let a stale build answer for it."""
+    import inspect
+
+    from amble.modelling.actuators import Actuators
+    from amble.modelling.hybrid import HybridSystem
+    from amble.modelling.model import Model
+    from amble.modelling.names import Names
+    from amble.modelling.walker import Walker
+
+    unmarked = []
+    for cls in (Names, Actuators, Model, HybridSystem, Walker):
+        for name, f in vars(cls).items():
+            if name.startswith("_") or not inspect.isfunction(f):
+                continue
+            if not getattr(f, "declares", False) and name not in _READS[cls.__name__]:
+                unmarked.append(f"{cls.__name__}.{name}")
+    assert not unmarked, f"mark these @declaration (they change the declaration) or list them as reads: {unmarked}"

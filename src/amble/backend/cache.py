@@ -14,11 +14,11 @@ The key is a hash of everything that shapes the compiled library:
   part of the key — :mod:`amble.backend.host`).
 
 The package sources are hashed once per process and the compiler identity once per compiler.
-A system's structural hash is computed once per system object: systems are mutable dataclasses
-but are declared once and not changed after their first build. A cheap fingerprint (the mode
-objects and the number of transitions) is checked on every call, so adding a transition or
-replacing a mode after a build is still caught; editing a mode's model in place after a build is
-not (build a new system instead).
+A system's structural hash is computed once per revision of its declaration. A cheap
+fingerprint (the mode objects and the revisions of the system and its models,
+:mod:`amble.modelling.revision`) is checked on every call: adding a transition, replacing a mode
+or editing a mode's model in place after a build (a damping force, a control law) makes the next
+use hash the declaration again and serve what it now says.
 
 The cache heals and cannot be steered:
 
@@ -283,9 +283,12 @@ def settings() -> tuple[str | None, str | None, str | None]:
 
 
 def fingerprint(system: HybridSystem) -> tuple:
-    """What a system's structural hash is checked against on every use: the number of transitions
-    and the identities of the mode objects (see the module docstring)."""
-    return (len(system.transitions), *map(id, system.modes.values()))
+    """What a system's structural hash is checked against on every use: the identities of the mode
+    objects and the revisions of the system and its modes (:mod:`amble.modelling.revision`: any
+    edit of a declaration advances one), so an edited declaration is hashed again, never served
+    the kernels of what it said before."""
+    modes = [(id(m), getattr(m, "revision", 0)) for m in system.modes.values()]
+    return (len(system.transitions), getattr(system, "revision", 0), *modes)
 
 
 @lru_cache(maxsize=256)

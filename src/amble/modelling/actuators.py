@@ -29,6 +29,7 @@ from ..errors import ModelError
 from .expressions import checked_expr
 from .geometry import t
 from .names import Names
+from .revision import declaration
 
 
 @dataclass(frozen=True)
@@ -60,6 +61,7 @@ class Actuators(Names):
             raise ModelError(f"model {self.name!r}: {what} name {name!r} is already taken by an input")
 
     # ------------------------------------------------------------------ declarations
+    @declaration
     def actuator(self, name: str, on: Any, limit: float | None = None, unit: str | None = None) -> sp.Symbol:
         """Declare an input acting on ``on`` (a coordinate, or an expression of the coordinates
         such as ``swing - stance``), bounded by ``|u| ≤ limit`` (N·m or N; None: unbounded).
@@ -127,6 +129,7 @@ class Actuators(Names):
         by = {v: k for k, v in self.derived_placeholders.items()}
         return (sp.Matrix(n, n, lambda i, j: by[("M", i, j)]), sp.Matrix(n, 1, lambda i, _: by[("h", i, 0)]))
 
+    @declaration
     def virtual_constraints(self, outputs: Any, phase: Any, alpha: Any, phase_range: tuple[float, float],
                             epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0) -> Any:
         """Control the inputs by hybrid zero dynamics: drive ``y = outputs(q) − h_d(phase(q), α)``
@@ -142,6 +145,7 @@ class Actuators(Names):
         self.declare_domains(epsilon=POSITIVE)
         return vc
 
+    @declaration
     def control(self, laws: Mapping[Any, Any], saturate: bool = False) -> None:
         """Set the closed-loop law ``{input: expression}`` (an input by symbol or name); the
         expressions may use ``q``, ``q̇``, ``t``, parameters and :meth:`dynamics`. Laws given

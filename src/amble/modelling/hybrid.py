@@ -39,6 +39,7 @@ from .dag import free_symbols
 from .expressions import checked_expr
 from .geometry import t as _TIME
 from .model import Model
+from .revision import Revised, declaration
 from .text import expr_of, parse
 from .transitions import Explicit, Guard, Impact, Lock, Reset, Transition
 
@@ -46,7 +47,7 @@ __all__ = ["Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Reset", "Tran
 
 
 @dataclass
-class HybridSystem:
+class HybridSystem(Revised):
     """Modes and transitions of a hybrid mechanical system.
 
     ``modes`` maps a mode name to its model (a single :class:`Model` makes one mode named after
@@ -80,6 +81,7 @@ class HybridSystem:
         _ = self.parameters  # validates consistent defaults
 
     # ------------------------------------------------------------------ declaring
+    @declaration
     def transition(
         self,
         name: str,
@@ -100,6 +102,7 @@ class HybridSystem:
         self.transitions.append(tr)
         return tr
 
+    @declaration
     def terminal(self, name: str, source: str | Sequence[str], guard: Guard | Any, status: str = "fell"
                  ) -> Transition:
         """Add a guard that ends the run with ``status`` (e.g. the hip touching the ground).
@@ -118,6 +121,7 @@ class HybridSystem:
         assert tr is not None
         return tr
 
+    @declaration
     def add_mode(self, name: str, model: Model) -> None:
         """Add a mode (e.g. the constrained mode of a resting contact)."""
         if name in self.modes:
@@ -127,6 +131,7 @@ class HybridSystem:
         self.modes[name] = model
         _ = self.parameters  # validates consistent defaults
 
+    @declaration
     def resting_contact(self, name: str, free: str, rest: str, gap: Any, impact: Reset, settle: Reset,
                         force: Any, leave: Reset) -> tuple[Transition, Transition, Transition]:
         """Declare the three transitions of a unilateral contact (usually built by

@@ -32,6 +32,7 @@ from .dag import dag_diff, free_symbols
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
 from .geometry import t
+from .revision import declaration
 from .tree import RigidTree
 
 
@@ -116,6 +117,7 @@ class Model(Actuators):
         return self.dt(self.points[name])
 
     # ------------------------------------------------------------------ geometry
+    @declaration
     def point(self, name: str, position: Any, mass: Any = None, link: str | None = None) -> sp.Matrix:
         """Name a point at ``position`` (2 or 3 components); optionally put a point mass there and
         draw a rigid link to an earlier point (``link``).
@@ -138,6 +140,7 @@ class Model(Actuators):
             self.link(link, name)
         return pos
 
+    @declaration
     def mass(self, point: str, m: Any) -> None:
         """Put a point mass ``m`` (kg) at the named point."""
         if point not in self.points:
@@ -146,6 +149,7 @@ class Model(Actuators):
         self._check_symbols(m, f"mass at {point!r}")
         self.masses[point] = self.masses.get(point, sp.Integer(0)) + m
 
+    @declaration
     def link(self, a: str, b: str) -> None:
         """Declare a rigid link between two named points (used for drawing)."""
         for p in (a, b):
@@ -153,6 +157,7 @@ class Model(Actuators):
                 raise ModelError(f"model {self.name!r}: link to unknown point {p!r}")
         self.links.append((a, b))
 
+    @declaration
     def rigid_tree(self) -> RigidTree:
         """The model's kinematic tree of rigid bodies and joints (created on first use; 3D only):
         ``model.rigid_tree().body(...)`` — see :mod:`amble.modelling.tree`."""
@@ -175,11 +180,13 @@ class Model(Actuators):
                            allow_massless=allow_massless, gravity=gravity, base_joint=base_joint,
                            base_coordinate=base_coordinate, parameters=parameters, pivot=pivot)
 
+    @declaration
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""
         moment = _expr(self, moment, "moment of inertia")
         self._k_terms.append(sp.Rational(1, 2) * moment * self.dt(_expr(self, angle, "inertia angle")) ** 2)
 
+    @declaration
     def body_inertia(self, rotation: Any, inertia: Any) -> None:
         """Rotational inertia of a 3D body with orientation ``rotation`` (3×3, body → world).
 
@@ -196,6 +203,7 @@ class Model(Actuators):
         self._k_terms.append(sp.Rational(1, 2) * (w.T * Im * w)[0, 0])
 
     # ------------------------------------------------------------------ energies
+    @declaration
     def gravity(self, g: Any, direction: Any = None) -> None:
         """Uniform gravity of magnitude ``g`` (m/s²) along ``direction`` (default: down, -z)."""
         self._g = _expr(self, g, "gravity")
@@ -206,11 +214,13 @@ class Model(Actuators):
             self._g_dir = d
         self._check_symbols(self._g, "gravity")
 
+    @declaration
     def add_kinetic(self, expr: Any) -> None:
         """Add a kinetic-energy term (J) in q and the velocity symbols."""
         self._k_terms.append(_expr(self, expr, "kinetic energy term"))
         self._k_added.append(self._k_terms[-1])
 
+    @declaration
     def add_potential(self, expr: Any) -> None:
         """Add a potential-energy term (J) in q, e.g. a spring ``k*(q1 - q2)**2/2``."""
         self._v_terms.append(_expr(self, expr, "potential energy term"))
@@ -268,6 +278,7 @@ class Model(Actuators):
         return self._g * self._g_dir
 
     # ------------------------------------------------------------------ forces
+    @declaration
     def force(self, generalized: Any) -> None:
         """Add a generalized force vector Γ (one entry per coordinate; may depend on q, q̇, t)."""
         v = _matrix(self, generalized, "generalized force")
@@ -277,6 +288,7 @@ class Model(Actuators):
             )
         self._forces.append(v)
 
+    @declaration
     def torque(self, tau: Any, angle: Any) -> None:
         """A torque ``tau`` (N·m) doing work on ``angle`` (an expression of q, e.g. a joint angle).
 
@@ -287,6 +299,7 @@ class Model(Actuators):
         tau = _expr(self, tau, "torque")
         self._forces.append(sp.Matrix([tau * sp.diff(angle, qi) for qi in self.q]))
 
+    @declaration
     def point_force(self, point: str, force: Any) -> None:
         """A force (N, world frame) applied at a named point; Γ = Jᵀ F."""
         if point not in self.points:

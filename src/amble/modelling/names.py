@@ -11,9 +11,10 @@ import sympy as sp
 from ..errors import ModelError
 from .domain import REAL, Domain
 from .geometry import t
+from .revision import Revised, declaration
 
 
-class Names:
+class Names(Revised):
     """Coordinates ``q`` (velocities ``qd``, named ``<coordinate>_dot``), parameters ``params``
     (symbol → default) and their ``units``, ``descriptions`` and ``domains`` (by name)."""
 
@@ -46,6 +47,7 @@ class Names:
 
         return parse(text, self.symbol_table(), what=f"model {self.name!r}", condition=condition)
 
+    @declaration
     def coordinates(self, names: str | Sequence[str], unit: str = "rad") -> tuple[sp.Symbol, ...]:
         """Declare generalized coordinates (in ``unit``, default radians); returns their symbols
         (velocities: :meth:`dot`)."""
@@ -62,10 +64,12 @@ class Names:
             out.append(s)
         return tuple(out)
 
+    @declaration
     def parameters(self, **defaults: float) -> tuple[sp.Symbol, ...]:
         """Declare parameters with default values, in keyword order; returns their symbols."""
         return tuple(self.parameter(k, v) for k, v in defaults.items())
 
+    @declaration
     def parameter(self, name: str, default: float, doc: str = "", unit: str = "", domain: Domain | None = None
                   ) -> sp.Symbol:
         """Declare one parameter with its default value, an optional one-line description, unit and
@@ -87,6 +91,7 @@ class Names:
             self.declare_domains(**{name: domain})
         return s
 
+    @declaration
     def declare_domains(self, **domains: Domain) -> None:
         """Physical domains of declared parameters, e.g. ``declare_domains(m=POSITIVE, slope=interval(-1, 1))``;
         each default must lie in its domain."""
@@ -100,6 +105,7 @@ class Names:
                 raise ModelError(f"model {self.name!r}: default {self.params[sym]:g} of {name!r} is outside {dom}")
             self.domains[name] = dom
 
+    @declaration
     def restrict(self, names: str | Sequence[str], domain: Domain) -> None:
         """Give several parameters one domain: ``restrict("mh m a b g", POSITIVE)``."""
         if isinstance(names, str):
@@ -121,6 +127,7 @@ class Names:
             if str(s) == name:
                 raise ModelError(f"model {self.name!r}: {what} name {name!r} is already taken")
 
+    @declaration
     def declare_units(self, **units: str) -> None:
         """Units of declared coordinates or parameters by name, e.g. ``declare_units(mh="kg", a="m")``."""
         known = {str(s) for s in [*self.q, *self.params]}
