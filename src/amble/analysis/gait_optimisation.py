@@ -30,9 +30,6 @@ with exact sparse first and second derivatives; IPOPT solves it.
 
 from __future__ import annotations
 
-import os
-import signal
-import sys
 import time
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -49,6 +46,7 @@ from .gait_hzd import bezier_start, virtual_constraints
 from .gait_result import Gait, bezier_fit, constraint_report
 from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
+from .solver_io import Interrupts, StdoutToStderr
 
 OBJECTIVES = ("effort", "cot")
 
@@ -288,7 +286,7 @@ def optimize_gait(
                          "ipopt.warm_start_bound_push": 1e-8, "ipopt.warm_start_mult_bound_push": 1e-8})
         solver = ca.nlpsol("gait", "ipopt", {"x": w, "f": J, "g": g}, opts)
         t0 = time.perf_counter()
-        with _stdout_to_stderr(progress), _Interrupts() as interrupted:
+        with StdoutToStderr(progress), Interrupts() as interrupted:
             sol = solver(x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
         if interrupted:  # CasADi turns Ctrl-C into a solver failure: it is the user's interrupt
             raise KeyboardInterrupt
@@ -411,54 +409,3 @@ def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: 
                 constraints=report, solver=solver, bezier=bezier_fit(model, fns, X, degree, P, alpha))
 
 
-class _Interrupts(list):
-    """Notes a Ctrl-C (SIGINT) during the solve (the list is non-empty afterwards) and raises it as
-    usual. CasADi catches the ``KeyboardInterrupt`` inside IPOPT's iteration and reports a
-    ``NonIpopt_Exception_Thrown`` failure, which would read as a result of the numbers."""
-
-    def __enter__(self) -> _Interrupts:
-        def note(signum: int, frame: Any) -> None:
-            self.append(signum)
-            raise KeyboardInterrupt
-
-        self.saved = None
-        if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
-            return self  # a process started to ignore Ctrl-C (a background job) keeps ignoring it
-        try:
-            self.saved = signal.signal(signal.SIGINT, note)
-        except ValueError:  # not the main thread: signals are not delivered here anyway
-            pass
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        if self.saved is not None:
-            signal.signal(signal.SIGINT, self.saved)
-
-
-class _stdout_to_stderr:
-    """Solver progress belongs on stderr (stdout may carry JSON). CasADi hands IPOPT's lines to
-    Python's ``sys.stdout``, and C code may print to the process's descriptor 1: both go to stderr."""
-
-    def __init__(self, active: bool) -> None:
-        self.active = active
-
-    def __enter__(self) -> None:
-        if self.active:
-            sys.stdout.flush()
-            self.saved_py = sys.stdout
-            sys.stdout = sys.stderr
-            self.saved = os.dup(1)
-            os.dup2(2, 1)
-
-    def __exit__(self, *exc: Any) -> None:
-        if self.active:
-            sys.stdout.flush()
-            sys.stdout = self.saved_py
-            try:
-                import ctypes
-
-                ctypes.CDLL(None).fflush(None)  # C-level buffers go to stderr before fd 1 is restored
-            except (OSError, AttributeError):  # pragma: no cover - no C library handle
-                pass
-            os.dup2(self.saved, 1)
-            os.close(self.saved)
