@@ -9,7 +9,7 @@ Run: ``python examples/limit_cycle.py``.
 
 import numpy as np
 
-from amble.analysis.poincare import find_fixed_point
+from amble import find_fixed_point
 from amble.models import load
 
 walker = load("compass-gait")

@@ -119,3 +119,30 @@ def test_every_method_of_a_declaration_either_reads_or_counts_its_change():
             if not getattr(f, "declares", False) and name not in _READS[cls.__name__]:
                 unmarked.append(f"{cls.__name__}.{name}")
     assert not unmarked, f"mark these @declaration (they change the declaration) or list them as reads: {unmarked}"
+
+
+#: Pages about amble's internals (code generation, the cache), which import them by design.
+_INTERNALS_PAGES = {"performance.md", "architecture.md"}
+
+
+def test_readme_docs_and_examples_use_the_public_api_only():
+    """What the README, the guides and the examples import is at the package root (or in
+    ``amble.models``, ``amble.viz``), so the names a user learns there are the stable ones."""
+    import re
+
+    import amble
+
+    root = SRC.parent.parent
+    pages = [root / "README.md", *(root / "docs").rglob("*.md"), *(root / "examples").glob("*.py"),
+             *(root / "examples").glob("*.ipynb")]
+    found, private = set(), []
+    for page in pages:
+        if page.name in _INTERNALS_PAGES:
+            continue
+        for mod, names in re.findall(r"from (amble[\w.]*) import ([\w, ]+)", page.read_text()):
+            if mod == "amble":
+                found |= {n.strip() for n in names.split(",")}
+            elif mod not in ("amble.models", "amble.viz") and not mod.startswith("amble.models."):
+                private.append(f"{page.name}: from {mod} import {names}")
+    assert not private
+    assert found <= set(amble.__all__), found - set(amble.__all__)
