@@ -124,27 +124,8 @@ def optimize_gait(
     :class:`SolverError` (naming the reason and the most violated constraint) when IPOPT fails.
     """
     ca = casadi_module()
-    if speed is not None and step_length is not None:
-        raise ParameterError("give speed or step_length, not both")
-    for name, v in (("speed", speed), ("step_length", step_length), ("mu", mu), ("step_time", step_time)):
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ParameterError(f"{name} must be a finite number > 0, got {v!r}")
-    if clearance is not None and not (np.isfinite(clearance) and clearance >= 0):
-        raise ParameterError(f"clearance must be a finite number ≥ 0, got {clearance!r}")
-    sizes = [nodes] if isinstance(nodes, int) else list(nodes)
-    if not sizes or not all(isinstance(k, int) and 2 <= k <= 2000 for k in sizes):
-        raise ParameterError(f"nodes must be an integer in [2, 2000] (or a list of them), got {nodes!r}")
-    vc = getattr(system.modes[system.mode_names[0]], "virtual", None)
-    if hzd is None:
-        hzd = vc is not None
-    if bezier_degree is None:
-        bezier_degree = vc.degree if vc is not None else 5
-    if not (isinstance(bezier_degree, int) and 1 <= bezier_degree <= 20):
-        raise ParameterError(f"bezier_degree must be an integer in [1, 20], got {bezier_degree!r}")
-    if not (isinstance(max_iter, int) and max_iter >= 1):
-        raise ParameterError(f"max_iter must be an integer ≥ 1, got {max_iter!r}")
-    if not (isinstance(steps, int) and 1 <= steps <= 8):
-        raise ParameterError(f"steps must be an integer in [1, 8], got {steps!r}")
+    hzd, bezier_degree = _check_options(system, speed, step_length, mu, step_time, clearance, nodes, hzd,
+                                        bezier_degree, max_iter, steps)
     S = steps
     pvals = _parameters(system, params)
     if step_params is not None and len(step_params) != S:
@@ -217,16 +198,9 @@ def optimize_gait(
                 add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
             if hzd:
                 add("virtual_constraints", virtual_constraints(fns, X, Pj, xg, AL))
-            if objective == "effort":
-                run = ca.sum1(U**2) if nu else ca.MX.zeros(1, K)
-                scale = 1.0
-            elif cot:
+            if cot:  # |power| = its positive plus its negative part, each ≥ 0
                 add("power", U * fns.actuator_rates.map(K)(Q, V, Pj) - (PW[:nu, :] - PW[nu:, :]))
-                run = ca.sum1(PW) if nu else ca.MX.zeros(1, K)
-                scale = 1.0 / float(fns.weight(Pj))
-            else:
-                run = fns.integrand.map(K)(Q, V, U, taus, Pj)
-                scale = 1.0
+            run, scale = _running_cost(ca, fns, objective, U, PW, Q, V, taus, Pj)
             integrals.append(scale * h * ca.mtimes(run, wts))
             # per unit distance: with the pace given, the distance is divided by its constrained
             # value (V T or the step length), not by the foot's position — equal at a feasible
@@ -284,26 +258,10 @@ def optimize_gait(
             # of re-solving from a central path (RABBIT 20 → 60 intervals: 10 iterations, not 83)
             opts.update({"ipopt.mu_init": 1e-5, "ipopt.warm_start_init_point": "yes",
                          "ipopt.warm_start_bound_push": 1e-8, "ipopt.warm_start_mult_bound_push": 1e-8})
-        solver = ca.nlpsol("gait", "ipopt", {"x": w, "f": J, "g": g}, opts)
-        t0 = time.perf_counter()
-        with StdoutToStderr(progress), Interrupts() as interrupted:
-            sol = solver(x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
-        if interrupted:  # CasADi turns Ctrl-C into a solver failure: it is the user's interrupt
-            raise KeyboardInterrupt
-        elapsed = time.perf_counter() - t0
-        stats = solver.stats()
+        sol, stats, report, elapsed = _solve_nlp(ca, {"x": w, "f": J, "g": g}, opts, progress, tol, groups,
+                                                 bound_groups, x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
         wopt = np.asarray(sol["x"]).ravel()
-        gval = np.asarray(sol["g"]).ravel()
-        report = constraint_report(groups, gval, lbg, ubg, wopt, lbw, ubw, bound_groups)
         status = stats.get("return_status", "unknown")
-        if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
-            worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
-            reason = _FAILURES.get(status, status.replace("_", " ").lower())
-            binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"
-                       if worst[1]["max_violation"] > tol else "at the starting point" if not stats.get("iter_count")
-                       else "every constraint holds at the last iterate (the optimality conditions do not)")
-            raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
-                              f"{binding}")
         info = {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed, "nodes": N}
         out, start = [], 0
         for j in range(S):
@@ -338,6 +296,76 @@ def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dic
         values[k] = float(v)
     system.check_parameters(values)
     return values
+
+
+def _running_cost(ca: Any, fns: StepFunctions, objective: Any, U: Any, PW: Any, Q: Any, V: Any, taus: Any,
+                  Pj: Any) -> tuple[Any, float]:
+    """The objective's integrand at the ``K`` points (a 1 × K row) and its scale: ``effort`` Σu²,
+    ``cot`` the absolute actuator power per unit weight, else the user's integrand."""
+    K, nu = Q.shape[1], U.shape[0]
+    if isinstance(objective, str) and objective == "effort":
+        return (ca.sum1(U**2) if nu else ca.MX.zeros(1, K)), 1.0
+    if isinstance(objective, str) and objective == "cot":
+        return (ca.sum1(PW) if nu else ca.MX.zeros(1, K)), 1.0 / float(fns.weight(Pj))
+    return fns.integrand.map(K)(Q, V, U, taus, Pj), 1.0
+
+
+def _solve_nlp(ca: Any, nlp: dict[str, Any], opts: dict[str, Any], progress: bool, tol: float,
+               groups: list[tuple[str, Any, float, float]], bound_groups: list[tuple[str, int, int]],
+               **problem: Any) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any], float]:
+    """IPOPT on ``nlp`` from ``problem`` (start and bounds): the solution, IPOPT's statistics, the
+    constraint report and the seconds it took; a failure is a :class:`SolverError` naming the reason
+    and the most violated constraint, Ctrl-C a ``KeyboardInterrupt``."""
+    solver = ca.nlpsol("gait", "ipopt", nlp, opts)
+    t0 = time.perf_counter()
+    with StdoutToStderr(progress), Interrupts() as interrupted:
+        sol = solver(**problem)
+    if interrupted:  # CasADi turns Ctrl-C into a solver failure: it is the user's interrupt
+        raise KeyboardInterrupt
+    elapsed = time.perf_counter() - t0
+    stats = solver.stats()
+    gval = np.asarray(sol["g"]).ravel()
+    report = constraint_report(groups, gval, problem["lbg"], problem["ubg"], np.asarray(sol["x"]).ravel(),
+                               problem["lbx"], problem["ubx"], bound_groups)
+    status = stats.get("return_status", "unknown")
+    if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
+        worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
+        reason = _FAILURES.get(status, status.replace("_", " ").lower())
+        binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"
+                   if worst[1]["max_violation"] > tol else "at the starting point" if not stats.get("iter_count")
+                   else "every constraint holds at the last iterate (the optimality conditions do not)")
+        raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
+                          f"{binding}")
+    return sol, stats, report, elapsed
+
+
+def _check_options(system: HybridSystem, speed: float | None, step_length: float | None, mu: float | None,
+                   step_time: float | None, clearance: float | None, nodes: Any, hzd: bool | None,
+                   bezier_degree: int | None, max_iter: Any, steps: Any) -> tuple[bool, int]:
+    """:class:`ParameterError` for an option out of its domain, before any work; returns ``hzd``
+    and ``bezier_degree`` with their defaults filled in (the model's virtual constraints, if any)."""
+    if speed is not None and step_length is not None:
+        raise ParameterError("give speed or step_length, not both")
+    for name, v in (("speed", speed), ("step_length", step_length), ("mu", mu), ("step_time", step_time)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise ParameterError(f"{name} must be a finite number > 0, got {v!r}")
+    if clearance is not None and not (np.isfinite(clearance) and clearance >= 0):
+        raise ParameterError(f"clearance must be a finite number ≥ 0, got {clearance!r}")
+    sizes = [nodes] if isinstance(nodes, int) else list(nodes)
+    if not sizes or not all(isinstance(k, int) and 2 <= k <= 2000 for k in sizes):
+        raise ParameterError(f"nodes must be an integer in [2, 2000] (or a list of them), got {nodes!r}")
+    vc = getattr(system.modes[system.mode_names[0]], "virtual", None)
+    if hzd is None:
+        hzd = vc is not None
+    if bezier_degree is None:
+        bezier_degree = vc.degree if vc is not None else 5
+    if not (isinstance(bezier_degree, int) and 1 <= bezier_degree <= 20):
+        raise ParameterError(f"bezier_degree must be an integer in [1, 20], got {bezier_degree!r}")
+    if not (isinstance(max_iter, int) and max_iter >= 1):
+        raise ParameterError(f"max_iter must be an integer ≥ 1, got {max_iter!r}")
+    if not (isinstance(steps, int) and 1 <= steps <= 8):
+        raise ParameterError(f"steps must be an integer in [1, 8], got {steps!r}")
+    return bool(hzd), bezier_degree
 
 
 def _integrand(model: Any, objective: Any) -> sp.Expr:

@@ -13,8 +13,9 @@ costs about 0.5 s); a missing CasADi is a :class:`~amble.errors.ModelError` sayi
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import sympy as sp
@@ -107,47 +108,48 @@ class CasadiTranslator:
                 out = memo[val] if cond is sp.true else ca.if_else(memo[cond], memo[val], out)
             return out
         args = [memo[a] for a in e.args]
-        if isinstance(e, sp.Add):
-            out = args[0]
-            for a in args[1:]:
-                out = out + a
-            return out
-        if isinstance(e, sp.Mul):
-            out = args[0]
-            for a in args[1:]:
-                out = out * a
-            return out
-        if isinstance(e, sp.Pow):
-            b, x = e.args
-            if x == sp.Rational(1, 2):
-                return ca.sqrt(args[0])
-            if x.is_Integer:
-                k = int(x)
-                return args[0] ** k if k > 0 else 1.0 / (args[0] ** (-k)) if k < 0 else 1.0
-            return args[0] ** args[1]
-        for f, name in _UNARY.items():
-            if isinstance(e, f):
-                return getattr(ca, name)(args[0])
-        if isinstance(e, sp.atan2):
-            return ca.atan2(args[0], args[1])
-        if isinstance(e, sp.Max):
-            return _fold(ca.fmax, args)
-        if isinstance(e, sp.Min):
-            return _fold(ca.fmin, args)
-        if isinstance(e, sp.Heaviside):
-            return ca.if_else(args[0] > 0, 1.0, ca.if_else(args[0] < 0, 0.0, 0.5))
-        rel = {sp.StrictGreaterThan: ca.gt, sp.GreaterThan: ca.ge, sp.StrictLessThan: ca.lt,
-               sp.LessThan: ca.le, sp.Equality: ca.eq, sp.Unequality: ca.ne}
-        for r, f in rel.items():
-            if isinstance(e, r):
-                return f(args[0], args[1])
-        if isinstance(e, sp.And):
-            return _fold(ca.logic_and, args)
-        if isinstance(e, sp.Or):
-            return _fold(ca.logic_or, args)
-        if isinstance(e, sp.Not):
-            return ca.logic_not(args[0])
+        for kind, op in _operations(ca):
+            if isinstance(e, kind):
+                return op(e, args)
         raise ModelError(f"no CasADi translation for {type(e).__name__} in {e}")
+
+
+def _power(ca: Any, e: sp.Pow, args: list[Any]) -> Any:
+    x = e.args[1]
+    if x == sp.Rational(1, 2):
+        return ca.sqrt(args[0])
+    if x.is_Integer:
+        k = int(x)
+        return args[0] ** k if k > 0 else 1.0 / (args[0] ** (-k)) if k < 0 else 1.0
+    return args[0] ** args[1]
+
+
+@lru_cache(maxsize=4)
+def _operations(ca: Any) -> tuple[tuple[type, Callable[[Any, list[Any]], Any]], ...]:
+    """How each compound sympy node becomes CasADi, given its children's values (checked in this
+    order: ``isinstance``, so a subclass finds its base's row)."""
+    rows: list[tuple[type, Callable[[Any, list[Any]], Any]]] = [
+        (sp.Add, lambda e, a: _fold(lambda u, v: u + v, a)),
+        (sp.Mul, lambda e, a: _fold(lambda u, v: u * v, a)),
+        (sp.Pow, lambda e, a: _power(ca, e, a)),
+    ]
+    unary = {f: getattr(ca, name) for f, name in _UNARY.items()}
+    rows += [(f, lambda e, a, fn=fn: fn(a[0])) for f, fn in unary.items()]
+    rows += [
+        (sp.atan2, lambda e, a: ca.atan2(a[0], a[1])),
+        (sp.Max, lambda e, a: _fold(ca.fmax, a)),
+        (sp.Min, lambda e, a: _fold(ca.fmin, a)),
+        (sp.Heaviside, lambda e, a: ca.if_else(a[0] > 0, 1.0, ca.if_else(a[0] < 0, 0.0, 0.5))),
+    ]
+    rel = {sp.StrictGreaterThan: ca.gt, sp.GreaterThan: ca.ge, sp.StrictLessThan: ca.lt,
+           sp.LessThan: ca.le, sp.Equality: ca.eq, sp.Unequality: ca.ne}
+    rows += [(r, lambda e, a, fn=f: fn(a[0], a[1])) for r, f in rel.items()]
+    rows += [
+        (sp.And, lambda e, a: _fold(ca.logic_and, a)),
+        (sp.Or, lambda e, a: _fold(ca.logic_or, a)),
+        (sp.Not, lambda e, a: ca.logic_not(a[0])),
+    ]
+    return tuple(rows)
 
 
 def _children(e: sp.Basic) -> tuple:
