@@ -146,3 +146,24 @@ def test_readme_docs_and_examples_use_the_public_api_only():
                 private.append(f"{page.name}: from {mod} import {names}")
     assert not private
     assert found <= set(amble.__all__), found - set(amble.__all__)
+
+
+_RESET_KINDS = {"Impact", "Lock", "Explicit"}
+
+
+def test_no_module_asks_a_reset_for_its_kind():
+    """What a layer does per kind of reset is a ``ResetVisitor`` (one method per kind): a new kind
+    is a class and a method in the visitor's base, not an edit of every ``isinstance`` chain."""
+    import ast
+
+    asked = []
+    for path in SRC.rglob("*.py"):
+        if path.name == "transitions.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) in ("isinstance", "issubclass"):
+                kinds = node.args[1:2]
+                names = {n.id for k in kinds for n in ast.walk(k) if isinstance(n, ast.Name)}
+                if names & _RESET_KINDS:
+                    asked.append(f"{path.relative_to(SRC)}:{node.lineno}")
+    assert not asked

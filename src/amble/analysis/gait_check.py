@@ -29,7 +29,6 @@ import numpy as np
 import sympy as sp
 
 from ..errors import AmbleError, ModelError
-from ..modelling.hybrid import Impact
 
 #: default friction coefficient of the stance foot
 MU = 0.7
@@ -132,11 +131,11 @@ def check_gait(traj: Any, mu: float = MU, margin: float = MARGIN) -> GaitCheck:
     n3 = _normal(system, traj.parameters)
     _, F_n, F_t = ground_reaction(traj)
     ratio = np.where(F_n > 0, F_t / np.where(F_n > 0, F_n, 1.0), np.inf)
-    steps = [tr for tr in system.transitions if tr.step and isinstance(tr.reset, Impact)]
+    steps = [tr for tr in system.transitions if tr.step and tr.reset is not None and tr.reset.impact_point]
     if not steps:
         raise ModelError(f"system {system.name!r}: check_gait needs footfalls that are impacts")
     names = k.meta["points"]
-    pidx = names.index(steps[0].reset.point)
+    pidx = names.index(steps[0].reset.impact_point)
     pos, _ = k.kinematics_rows(traj.t, traj.mode, traj.x, p)
     height = pos[:, pidx, :] @ n3
     ev_t = [traj.t[0]] + [e.t for e in traj.step_events] + [traj.t[-1]]

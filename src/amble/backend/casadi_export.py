@@ -247,7 +247,6 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     """
     from ..derivation.equations import derive
     from ..derivation.impact import impulse_data
-    from ..modelling.hybrid import Impact
     from ..modelling.model import t as time
 
     ca = casadi_module()
@@ -257,7 +256,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
         raise ModelError(f"system {system.name!r}: gait optimisation needs one mode and one footfall back into it "
                          f"(it has modes {modes} and {len(steps)} footfall transition(s))")
     tr = steps[0]
-    if not isinstance(tr.reset, Impact):
+    if tr.reset is None or tr.reset.impact_point is None:
         raise ModelError(f"system {system.name!r}: the footfall {tr.name!r} must be an Impact (derived) reset, "
                          f"not {type(tr.reset).__name__}")
     m = system.modes[modes[0]]
@@ -306,7 +305,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     slope = sp.sympify(getattr(system, "slope", 0))
     nvec = [sp.sin(slope), sp.cos(slope)] if d == 2 else [sp.sin(slope), 0, sp.cos(slope)]
     dvec = [sp.cos(slope), -sp.sin(slope)] if d == 2 else [sp.cos(slope), 0, -sp.sin(slope)]
-    foot = m.points[tr.reset.point]
+    foot = m.points[tr.reset.impact_point]
     dist = sum((dvec[i] * foot[i] for i in range(d)), sp.Integer(0))
     distance = ca.Function("distance", [q, p], [T(dist)], ["q", "p"], ["distance"])
     normal = ca.Function("normal", [p], [T.matrix(nvec)], ["p"], ["n"])

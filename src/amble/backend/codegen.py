@@ -22,7 +22,7 @@ from sympy.core.relational import Relational
 from ..derivation.equations import derive
 from ..derivation.impact import impulse_data
 from ..derivation.switching import switching_surfaces
-from ..modelling.hybrid import Explicit, HybridSystem, target_exprs
+from ..modelling.hybrid import HybridSystem, target_exprs
 from ..modelling.model import t
 from . import abi
 from .codegen_support import ModeInfo
@@ -378,9 +378,10 @@ def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict,
     what = f"reset of transition {tr.name!r}"
     body = f"    *target = {dst.index};\n"
     reset = tr.reset
-    if isinstance(reset, Explicit):
-        qn = target_exprs(dst.model, reset.q, what, source=m)
-        vn = target_exprs(dst.model, reset.qd, what, velocities=True, source=m)
+    if reset.written is not None:  # written out: the target state as given
+        q_to, qd_to = reset.written
+        qn = target_exprs(dst.model, q_to, what, source=m)
+        vn = target_exprs(dst.model, qd_to, what, velocities=True, source=m)
         body += f"    double y[{2 * nd}];\n"
         body += _block([f"y[{j}]" for j in range(2 * nd)], hoist(qn + vn), {**nm, **hoist.names})
         body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"

@@ -23,7 +23,7 @@ from dataclasses import replace
 import sympy as sp
 
 from ..derivation.impact import impulse_data
-from ..modelling.hybrid import Explicit, target_exprs
+from ..modelling.hybrid import target_exprs
 from ..modelling.model import Model, t
 from .codegen_support import ModeInfo, symbol_names
 from .tangents import jacobian_block
@@ -140,9 +140,10 @@ def reset_jacobian_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], n
     what = f"reset of transition {tr.name!r}"
     inputs, cols = _inputs(m, params, with_time=True)
     clear = f"    for (int a = 0; a < {2 * nd} * (SC + 1); ++a) D[a] = 0.0;\n"
-    if isinstance(tr.reset, Explicit):
-        exprs = target_exprs(dst.model, tr.reset.q, what, source=m)
-        exprs += target_exprs(dst.model, tr.reset.qd, what, velocities=True, source=m)
+    if tr.reset.written is not None:  # written out: the Jacobian of the given target state
+        q_to, qd_to = tr.reset.written
+        exprs = target_exprs(dst.model, q_to, what, source=m)
+        exprs += target_exprs(dst.model, qd_to, what, velocities=True, source=m)
         code = jacobian_block(exprs, [None] * len(exprs), lambda o, j: f"D[{o} * (SC + 1) + {cols[j]}]", inputs, names)
         return head + clear + code + "    return 0;\n}\n"
     defs, Mc, _ = _defs(src)

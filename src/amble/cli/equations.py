@@ -12,7 +12,7 @@ import sympy as sp
 
 from ..derivation.equations import derive, latex_matrix, latex_names, tidy
 from ..derivation.impact import impulse_data
-from ..modelling.hybrid import Explicit, Impact, Lock, target_exprs
+from ..modelling.hybrid import Explicit, Impact, Lock, ResetVisitor, target_exprs
 from .args import load_model
 
 _DIRECTION = {-1: "falling through 0", 1: "rising through 0", 0: "crossing 0"}
@@ -43,15 +43,28 @@ def _reset(system, tr, cache: dict) -> dict[str, Any] | None:
     if reset is None:
         return None
     src, dst = system.modes[tr.source], system.modes[tr.target]
-    names = latex_names(src)
-    out: dict[str, Any] = {"type": type(reset).__name__}
-    if isinstance(reset, (Impact, Lock)):
-        data = impulse_data(src, cache[tr.source], reset, dst, what=f"transition {tr.name!r}")
+    return {"type": type(reset).__name__, **reset.accept(_ResetDisplay(src, dst, cache[tr.source], tr.name))}
+
+
+class _ResetDisplay(ResetVisitor[dict[str, Any]]):
+    """A reset as the ``equations`` command shows it: matrices as text and as LaTeX."""
+
+    def __init__(self, src: Any, dst: Any, equations: Any, name: str) -> None:
+        self.src, self.dst, self.equations, self.what = src, dst, equations, f"transition {name!r}"
+        self.names = latex_names(src)
+
+    def impact(self, reset: Impact) -> dict[str, Any]:
+        return {"point": reset.point, **self.impulsive(reset)}
+
+    def lock(self, reset: Lock) -> dict[str, Any]:
+        return {"constraint": _text(reset.constraint), **self.impulsive(reset)}
+
+    def impulsive(self, reset: Impact | Lock) -> dict[str, Any]:
+        src, dst, names = self.src, self.dst, self.names
+        data = impulse_data(src, self.equations, reset, dst, what=self.what)
         n = len(src.q)
         base = [f"base_{axis}_dot" for axis in "xyz"[: data.Me.rows - n]]
-        out.update({
-            "point" if isinstance(reset, Impact) else "constraint":
-                reset.point if isinstance(reset, Impact) else _text(reset.constraint),
+        return {
             "form": "M_e (qd_e+ - qd_e-) = J^T lambda,  J qd_e+ = 0,  qd_new = (dr/dq) qd+",
             "extended_velocities": [str(v) for v in src.qd] + base,
             "Me": _rows(data.Me), "J": _rows(data.Jc),
@@ -60,15 +73,16 @@ def _reset(system, tr, cache: dict) -> dict[str, Any] | None:
             "latex": {"Me": latex_matrix(data.Me, names), "J": latex_matrix(data.Jc, names),
                       "relabel": latex_matrix(sp.Matrix(data.q_new), names),
                       "velocity_map": latex_matrix(data.velocity_map, names)},
-        })
-    elif isinstance(reset, Explicit):
-        q_new = target_exprs(dst, reset.q, f"transition {tr.name!r}", source=src)
-        qd_new = target_exprs(dst, reset.qd, f"transition {tr.name!r}", velocities=True, source=src)
-        out.update({"relabel": {str(d): _text(e) for d, e in zip(dst.q, q_new)},
-                    "velocities": {str(d): _text(e) for d, e in zip(dst.qd, qd_new)},
-                    "latex": {"relabel": latex_matrix(sp.Matrix(q_new), names),
-                              "velocities": latex_matrix(sp.Matrix(qd_new), names)}})
-    return out
+        }
+
+    def explicit(self, reset: Explicit) -> dict[str, Any]:
+        src, dst, names = self.src, self.dst, self.names
+        q_new = target_exprs(dst, reset.q, self.what, source=src)
+        qd_new = target_exprs(dst, reset.qd, self.what, velocities=True, source=src)
+        return {"relabel": {str(d): _text(e) for d, e in zip(dst.q, q_new)},
+                "velocities": {str(d): _text(e) for d, e in zip(dst.qd, qd_new)},
+                "latex": {"relabel": latex_matrix(sp.Matrix(q_new), names),
+                          "velocities": latex_matrix(sp.Matrix(qd_new), names)}}
 
 
 def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:

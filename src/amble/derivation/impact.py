@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import ModelError
-from ..modelling.hybrid import Impact, Lock, Reset, target_exprs
+from ..modelling.hybrid import Impact, Lock, Reset, ResetVisitor, target_exprs
 from ..modelling.model import Model
 from ..modelling.tree import RigidTree
 from .equations import Equations
@@ -112,6 +112,21 @@ def lock_jacobian(model: Model, constraint: sp.Expr) -> sp.Matrix:
     return sp.Matrix([[sp.diff(c, qi) for qi in model.q]])
 
 
+class _ImpulseMatrices(ResetVisitor[tuple[sp.Matrix, sp.Matrix]]):
+    """``(Me, Jc)`` of an impulsive reset: the (extended) mass matrix and the Jacobian of what
+    the impulse enforces (the impacting point's velocity, or the lock constraint's rate)."""
+
+    def __init__(self, model: Model, equations: Equations, compact: bool, what: str) -> None:
+        self.model, self.equations, self.compact = model, equations, compact
+        self.what = f"{what}: not an impulsive reset (Impact or Lock)"
+
+    def impact(self, reset: Impact) -> tuple[sp.Matrix, sp.Matrix]:
+        return extended_impact_data(self.model, self.equations, reset.point, self.compact)
+
+    def lock(self, reset: Lock) -> tuple[sp.Matrix, sp.Matrix]:
+        return self.equations.M, lock_jacobian(self.model, reset.constraint)
+
+
 def impulse_data(model: Model, equations: Equations, reset: Reset, target_model: Model,
                  what: str = "reset", compact: bool = False) -> ImpulseData:
     """The impulsive reset of an :class:`~amble.modelling.hybrid.Impact` or
@@ -119,12 +134,7 @@ def impulse_data(model: Model, equations: Equations, reset: Reset, target_model:
     ``target_model``; ``what`` names the transition in error messages. ``compact``: ``Me`` and
     ``Jc`` of a tree model in its named intermediate quantities, listed in
     :attr:`ImpulseData.defs` (``equations.M`` is then the compact ``M``, as code generation has it)."""
-    if isinstance(reset, Impact):
-        Me, Jc = extended_impact_data(model, equations, reset.point, compact)
-    elif isinstance(reset, Lock):
-        Me, Jc = equations.M, lock_jacobian(model, reset.constraint)
-    else:
-        raise ModelError(f"{what}: {type(reset).__name__} is not an impulsive reset (Impact or Lock)")
+    Me, Jc = reset.accept(_ImpulseMatrices(model, equations, compact, what))
     q_new = target_exprs(target_model, reset.relabel, what, source=model)
     # model.jacobian: a tree's relabelling (the new base's angles from a foot's rotation) is a
     # shared graph, differentiated once per shared part

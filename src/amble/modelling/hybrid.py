@@ -41,9 +41,10 @@ from .geometry import t as _TIME
 from .model import Model
 from .revision import Revised, declaration
 from .text import expr_of, parse
-from .transitions import Explicit, Guard, Impact, Lock, Reset, Transition
+from .transitions import Explicit, Guard, Impact, Lock, Reset, ResetVisitor, Transition
 
-__all__ = ["Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Reset", "Transition", "target_exprs"]
+__all__ = ["Explicit", "Guard", "HybridSystem", "Impact", "Lock", "Reset", "ResetVisitor", "Transition",
+           "target_exprs"]
 
 
 @dataclass
@@ -353,25 +354,40 @@ def target_exprs(target: Model, mapping: Any, what: str, velocities: bool = Fals
 
 def _check_reset(src: Model, dst: Model, reset: Reset, name: str) -> None:
     what = f"reset of transition {name!r}"
-    if isinstance(reset, Impact):
-        if reset.point not in src.points:
-            raise ModelError(f"{what}: impact point {reset.point!r} is not a point of mode {src.name!r}")
-        exprs = target_exprs(dst, reset.relabel, what, source=src)
-        _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
-    elif isinstance(reset, Lock):
-        c = checked_expr(src.name, reset.constraint, f"{what}: lock constraint")
-        if not (c.free_symbols & set(src.q)):
-            raise ModelError(f"{what}: lock constraint {c} does not depend on the coordinates")
-        exprs = target_exprs(dst, reset.relabel, what, source=src)
-        _check_free(exprs, set(src.q) | set(src.params), what, "source coordinates")
-    elif isinstance(reset, Explicit):
+    if not isinstance(reset, Reset):
+        raise ModelError(f"{what}: expected Impact, Lock or Explicit, got {type(reset).__name__}")
+    reset.accept(_ResetCheck(src, dst, what))
+
+
+class _ResetCheck(ResetVisitor[None]):
+    """A reset checked against its source and target modes when it is declared."""
+
+    def __init__(self, src: Model, dst: Model, what: str) -> None:
+        self.src, self.dst, self.what = src, dst, what
+
+    def impact(self, reset: Impact) -> None:
+        if reset.point not in self.src.points:
+            raise ModelError(f"{self.what}: impact point {reset.point!r} is not a point of mode {self.src.name!r}")
+        self.impulsive(reset)
+
+    def lock(self, reset: Lock) -> None:
+        c = checked_expr(self.src.name, reset.constraint, f"{self.what}: lock constraint")
+        if not (c.free_symbols & set(self.src.q)):
+            raise ModelError(f"{self.what}: lock constraint {c} does not depend on the coordinates")
+        self.impulsive(reset)
+
+    def impulsive(self, reset: Impact | Lock) -> None:
+        src = self.src
+        exprs = target_exprs(self.dst, reset.relabel, self.what, source=src)
+        _check_free(exprs, set(src.q) | set(src.params), self.what, "source coordinates")
+
+    def explicit(self, reset: Explicit) -> None:
+        src, dst, what = self.src, self.dst, self.what
         exprs = target_exprs(dst, reset.q, what, source=src) + target_exprs(dst, reset.qd, what, True, src)
         allowed = set(src.q) | set(src.qd) | set(src.params) | {sp.Symbol("t", real=True)}
         _check_free(exprs, allowed, what, "source state")
         if reset.shift is not None and reset.shift not in src.points:
             raise ModelError(f"{what}: shift point {reset.shift!r} is not a point of mode {src.name!r}")
-    else:
-        raise ModelError(f"{what}: expected Impact, Lock or Explicit, got {type(reset).__name__}")
 
 
 def _check_free(exprs: list[sp.Expr], allowed: set, what: str, label: str) -> None:

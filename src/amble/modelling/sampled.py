@@ -29,7 +29,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .geometry import t
-from .hybrid import Explicit, Guard, HybridSystem, Impact, Lock, Transition
+from .hybrid import Explicit, Guard, HybridSystem, Impact, Lock, Reset, ResetVisitor, Transition
 from .model import Model
 
 
@@ -54,6 +54,16 @@ def _extend(m: Model) -> tuple[Model, sp.Symbol, list[sp.Symbol]]:
     return out, clock, held
 
 
+class _KeepHeld(ResetVisitor[Reset]):
+    """An impulsive reset that also carries the clock and the held inputs across unchanged."""
+
+    def __init__(self, keep: dict, what: str) -> None:
+        self.keep, self.what = keep, what
+
+    def impulsive(self, reset: Impact | Lock) -> Reset:
+        return dataclasses.replace(reset, relabel={**dict(reset.relabel), **self.keep})
+
+
 def sample_and_hold(system: HybridSystem, rate: float) -> HybridSystem:
     """The system under its control laws sampled at ``rate`` (Hz) and held (see the module).
 
@@ -75,11 +85,8 @@ def sample_and_hold(system: HybridSystem, rate: float) -> HybridSystem:
         reset = tr.reset
         src_extra, dst_extra = extra[tr.source], extra[tr.target]
         keep = dict(zip([dst_extra[0], *dst_extra[1]], [src_extra[0], *src_extra[1]]))
-        if isinstance(reset, (Impact, Lock)):
-            reset = dataclasses.replace(reset, relabel={**dict(reset.relabel), **keep})
-        elif isinstance(reset, Explicit):
-            raise ModelError(f"system {system.name!r}: sample-and-hold of an explicit reset ({tr.name!r}) is not "
-                             "supported")
+        if reset is not None:
+            reset = reset.accept(_KeepHeld(keep, f"system {system.name!r}: sample-and-hold of {tr.name!r}"))
         transitions.append(Transition(tr.name, tr.source, tr.target, tr.guard, reset, tr.terminal, tr.step))
     out = dataclasses.replace(system, modes=modes, transitions=transitions, default_start={},
                               fixed_point_guess=None)

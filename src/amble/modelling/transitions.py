@@ -1,13 +1,22 @@
 """Transitions of a hybrid system as declarations: the guard (witness function), the reset
-(:class:`Impact`, :class:`Lock`, :class:`Explicit`) and the transition that joins them; how they
-are validated against their modes and compiled lives in :mod:`amble.modelling.hybrid` and the
-backend."""
+(:class:`Impact`, :class:`Lock`, :class:`Explicit`) and the transition that joins them.
+
+What a layer does with a reset — validate it, derive its impulse, generate its C, export it to
+CasADi, display it — is one :class:`ResetVisitor` in that layer, with one method per kind of
+reset; a reset hands itself to the right method (:meth:`Reset.accept`). No module asks a reset
+for its type: a new kind of reset is a class here and one method in each visitor's base, and
+every operation that does not know it yet says so by name (the base methods raise).
+"""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Generic, TypeVar
+
+from ..errors import ModelError
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -36,6 +45,36 @@ class Reset:
 
     #: name of the point whose pre-event position becomes the new origin (None: no shift)
     shift_point: str | None = None
+    #: name of the point whose impact with the ground this reset is (None: not a ground impact)
+    impact_point: str | None = None
+    #: the target state written out, ``(q, qd)`` as given (None: the reset is derived, impulsive)
+    written: tuple[Any, Any] | None = None
+
+    def accept(self, visitor: ResetVisitor[T]) -> T:
+        """``visitor``'s method for this kind of reset, applied to it."""
+        raise ModelError(f"{type(self).__name__} is not a kind of reset amble knows (Impact, Lock or Explicit)")
+
+
+class ResetVisitor(Generic[T]):
+    """One operation over every kind of reset (see the module docstring).
+
+    :class:`Impact` and :class:`Lock` are *impulsive* (the post-event velocity solves an impulse
+    problem; the coordinates are relabelled): unless overridden, both go to :meth:`impulsive`.
+    ``what`` names the transition in the messages of the methods a visitor does not provide."""
+
+    what = "reset"
+
+    def impact(self, reset: Impact) -> T:
+        return self.impulsive(reset)
+
+    def lock(self, reset: Lock) -> T:
+        return self.impulsive(reset)
+
+    def impulsive(self, reset: Impact | Lock) -> T:
+        raise ModelError(f"{self.what}: an impulsive reset ({type(reset).__name__}) is not supported here")
+
+    def explicit(self, reset: Explicit) -> T:
+        raise ModelError(f"{self.what}: an explicit reset is not supported here")
 
 
 @dataclass
@@ -56,6 +95,13 @@ class Impact(Reset):
     def shift_point(self) -> str:  # type: ignore[override]
         return self.point
 
+    @property
+    def impact_point(self) -> str:  # type: ignore[override]
+        return self.point
+
+    def accept(self, visitor: ResetVisitor[T]) -> T:
+        return visitor.impact(self)
+
 
 @dataclass
 class Lock(Reset):
@@ -67,6 +113,9 @@ class Lock(Reset):
 
     constraint: Any
     relabel: Mapping[Any, Any]
+
+    def accept(self, visitor: ResetVisitor[T]) -> T:
+        return visitor.lock(self)
 
 
 @dataclass
@@ -85,6 +134,13 @@ class Explicit(Reset):
     @property
     def shift_point(self) -> str | None:  # type: ignore[override]
         return self.shift
+
+    @property
+    def written(self) -> tuple[Any, Any]:  # type: ignore[override]
+        return self.q, self.qd
+
+    def accept(self, visitor: ResetVisitor[T]) -> T:
+        return visitor.explicit(self)
 
 
 @dataclass
