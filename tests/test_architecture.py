@@ -95,7 +95,7 @@ _READS = {
     "Names": {"symbol_table", "parse", "domain", "unit", "dot", "symbol"},
     "Actuators": {"input_unit", "input_matrix", "dynamics"},
     "Model": {"dt", "diff", "jacobian", "point_jacobian", "point_velocity", "from_urdf", "constrained", "validate"},
-    "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names"},
+    "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names", "full"},
     "Walker": {"slope_value", "frame_change"},
 }
 

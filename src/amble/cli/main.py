@@ -93,7 +93,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--time must be positive, got {args.time}")
     drawn = bool(plot_p or anim_p)
     s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or args.method == "radau")
-    if out_p and hasattr(s, "full") and any(m.inputs for m in s.modes.values()):
+    if out_p and any(m.inputs for m in s.modes.values()):
         s = s.full()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
@@ -155,8 +155,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
         from ..analysis.gait_check import check_gait
 
-        if hasattr(s, "full"):  # the checks read the symbolic model (contact forces, the control law)
-            lc.hybrid_system = s.full()
+        lc.hybrid_system = s.full()  # the checks read the symbolic model (contact forces, the control law)
 
         # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
         gait = lc.trajectory(steps=lc.period)

@@ -195,6 +195,12 @@ class HybridSystem(Revised):
                 out[k] = v
         return out
 
+    def full(self) -> HybridSystem:
+        """The symbolic system: this one. A system known only by its compiled library
+        (:class:`~amble.backend.compiled.CompiledSystem`) builds it here on first use, so code that
+        needs the symbols (a control law, contact forces) asks any system the same way."""
+        return self
+
     def check_parameters(self, values: Mapping[str, float]) -> None:
         """Raise :class:`ParameterError` for a value outside its parameter's declared domain."""
         for name, v in values.items():
