@@ -9,9 +9,13 @@ a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
 
 * a joint of a type other than revolute, continuous, prismatic or fixed (``floating`` and
   ``planar`` included: the base is chosen, not floating),
+* a file that is not well-formed XML (cut short, a NUL byte), two links or joints of one name,
+  a ``<mimic>`` of a joint the file does not declare — found by a strict parse before the
+  parser's own, which recovers from them silently,
 * a link reached twice (a kinematic loop, or a link with two parents),
-* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative mass,
-  an inertia tensor that is not symmetric positive definite.
+* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative or
+  non-finite mass, an inertia tensor that is not finite, not symmetric, not positive definite
+  (for a link with mass), or whose principal moments break the triangle inequality.
 
 The user chooses the base link, fixed to the world (e.g. the stance foot): the tree is re-rooted
 there, joints between the base and the URDF root are traversed backwards (the same joint

@@ -20,7 +20,9 @@ from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, 
 from ..backend.kernels import Kernels
 from ..errors import StateError
 
-#: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB.
+#: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB. The
+#: buffers are what the trajectory holds (a grown buffer is handed over cut, not copied), so
+#: this bounds the growth of the process's peak memory by the recording too.
 RECORD_BUDGET = 512 * 2**20
 
 #: Integrators, in the order of the compiled loop's IO_METHOD codes.
