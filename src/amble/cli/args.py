@@ -11,7 +11,7 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..errors import AmbleError, OutputError
+from ..errors import AmbleError, ModelError, OutputError
 
 #: Most points of a sweep grid (all ranges together): a million rows of results take about a
 #: gigabyte in memory, and the grid itself is allocated before any work.
@@ -120,7 +120,23 @@ def load_model(name: str, *, compiled: bool = False, derivatives: bool = False):
     ``compiled``: a :class:`~amble.backend.compiled.CompiledSystem` when the warm-start index
     (:mod:`amble.backend.index`) holds the model's compiled library (with the derivative kernels
     if ``derivatives``) — no SymPy is imported; otherwise the model is built and its index entry
-    refreshed, so that the next run starts warm."""
+    refreshed, so that the next run starts warm.
+
+    A model file that calls ``sys.exit()`` while it is loaded, or a path the operating system
+    cannot look up (too long, a NUL byte), is a :class:`~amble.errors.ModelError`: the command
+    would otherwise end with the file's exit code and no output, or with an internal error."""
+    from ..models import is_file_spec
+
+    if is_file_spec(name):
+        _check_model_path(name)
+    try:
+        return _load(name, compiled, derivatives)
+    except SystemExit as e:  # not an Exception: it would pass every handler up to the interpreter
+        raise ModelError(f"model file {_shown(name)} called sys.exit({e.code!r}) while it was loaded; "
+                         "a model file builds a system and returns it") from None
+
+
+def _load(name: str, compiled: bool, derivatives: bool):
     from ..models import is_file_spec, load, load_file, load_traced, source_files
 
     if not compiled:
@@ -134,3 +150,21 @@ def load_model(name: str, *, compiled: bool = False, derivatives: bool = False):
     system, read = load_traced(name)
     index.record(name, sources, system, read)
     return system
+
+
+def _shown(name: str, most: int = 80) -> str:
+    """``name`` quoted for a one-line message, shortened past ``most`` characters."""
+    return repr(name) if len(name) <= most else f"{name[:most]!r}… ({len(name)} characters)"
+
+
+def _check_model_path(spec: str) -> None:
+    """:class:`ModelError` if the path of the model file ``spec`` (``path.py[:callable]``) cannot
+    be looked up at all; a path that names no file is left to the loader (which says so)."""
+    path = spec if spec.endswith(".py") else spec.rpartition(":")[0]
+    try:
+        os.stat(path)
+    except FileNotFoundError:
+        return
+    except (OSError, ValueError) as e:  # ENAMETOOLONG, ELOOP, EACCES …; ValueError: a NUL byte
+        why = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
+        raise ModelError(f"model file {_shown(path)}: cannot be opened ({why})") from None

@@ -21,6 +21,7 @@ convention of the thesis and of Drake (from the vertical, positive in the walkin
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import sympy as sp
@@ -29,6 +30,7 @@ from ..errors import ModelError
 from .actuators import Actuators
 from .constrained_tree import ConstrainedTree
 from .dag import dag_diff, free_symbols
+from .domain import POSITIVE
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
 from .geometry import t
@@ -147,6 +149,7 @@ class Model(Actuators):
             raise ModelError(f"model {self.name!r}: mass placed at unknown point {point!r}")
         m = _expr(self, m, f"mass at {point!r}")
         self._check_symbols(m, f"mass at {point!r}")
+        self._check_mass(m, f"mass at point {point!r}", zero=False)
         self.masses[point] = self.masses.get(point, sp.Integer(0)) + m
 
     @declaration
@@ -379,6 +382,26 @@ class Model(Actuators):
                 f"model {self.name!r}: {what} uses {', '.join(bad)}, which "
                 f"{'is' if len(bad) == 1 else 'are'} neither a coordinate nor a parameter"
             )
+
+    def _check_mass(self, m: sp.Expr, what: str, zero: bool) -> None:
+        """A mass (kg) as declared: a number must be finite and positive (``zero``: or zero, a
+        massless frame of a rigid-body tree), else :class:`ModelError` naming ``what``.
+
+        A mass that is one parameter, or one parameter times a positive number, makes that
+        parameter's domain positive (unless one was declared, or its default is not: then
+        :meth:`validate` names the mass): a negative value given at run time would otherwise
+        reach the integrator as a mass matrix that is not positive definite, and end the run as
+        ``singular_mass`` instead of being refused as the input it is."""
+        if m.is_number:
+            v = float(m)
+            if not (math.isfinite(v) and (v > 0 or (zero and v == 0))):
+                need = "non-negative" if zero else "positive"
+                raise ModelError(f"model {self.name!r}: {what} must be a finite {need} number, got {v:g}")
+            return
+        coeff, rest = m.as_coeff_Mul()
+        if rest in self.params and coeff > 0 and str(rest) not in self.domains \
+                and self.params[rest] in POSITIVE:
+            self.domains[str(rest)] = POSITIVE
 
     def validate(self) -> None:
         """Check the model is complete and physically sensible at the default parameters."""

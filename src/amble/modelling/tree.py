@@ -211,6 +211,7 @@ class RigidTree:
         b = Body(name=name, parent=par, joint=joint, mass=mass_e, com=_vec(com), inertia=_mat3(inertia))
         if b.com.shape != (3, 1):
             raise ModelError(f"model {m.name!r}: centre of mass of body {name!r} needs 3 components")
+        self._check_inertial(b)
         if joint.type != "fixed":
             a = np.asarray([float(v) for v in joint.axis])
             na = float(np.linalg.norm(a))
@@ -238,6 +239,19 @@ class RigidTree:
         if par is not None:
             m.link(par.name, name)
         return b
+
+    def _check_inertial(self, b: Body) -> None:
+        """:class:`ModelError` naming the body for a negative or non-finite numeric mass (zero is
+        a massless frame: a composite joint's, or a link without an inertial) or a non-finite
+        numeric entry of its centre of mass or inertia tensor; a symbolic mass makes its
+        parameter's domain positive (:meth:`Model._check_mass`). Positive definiteness is not
+        asked: a link of zero inertia is a point mass."""
+        m = self.model
+        m._check_mass(b.mass, f"mass of body {b.name!r}", zero=True)
+        for what, entries in (("centre of mass", b.com), ("inertia", b.inertia)):
+            bad = [e for e in entries if e.is_number and not (e.is_finite and e.is_extended_real)]
+            if bad:
+                raise ModelError(f"model {m.name!r}: {what} of body {b.name!r} has a non-finite entry {bad[0]}")
 
     def point(self, name: str, body: str, at: Sequence[Any] = (0, 0, 0)) -> sp.Matrix:
         """Name a point fixed on ``body`` at ``at`` (body frame); returns its world position."""

@@ -9,9 +9,13 @@ a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
 
 * a joint of a type other than revolute, continuous, prismatic or fixed (``floating`` and
   ``planar`` included: the base is chosen, not floating),
+* a file that is not well-formed XML (cut short, a NUL byte), two links or joints of one name,
+  a ``<mimic>`` of a joint the file does not declare — found by a strict parse before the
+  parser's own, which recovers from them silently,
 * a link reached twice (a kinematic loop, or a link with two parents),
-* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative mass,
-  an inertia tensor that is not symmetric positive definite.
+* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative or
+  non-finite mass, an inertia tensor that is not finite, not symmetric, not positive definite
+  (for a link with mass), or whose principal moments break the triangle inequality.
 
 The user chooses the base link, fixed to the world (e.g. the stance foot): the tree is re-rooted
 there, joints between the base and the URDF root are traversed backwards (the same joint
@@ -33,6 +37,7 @@ and characters other than letters, digits and ``_`` in a name become ``_``.
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from collections.abc import Collection, Mapping
 from pathlib import Path
@@ -88,6 +93,7 @@ def _read(path: Path) -> Any:
         import yourdfpy
     except ImportError as e:  # pragma: no cover - a declared dependency
         raise ModelError("URDF import needs the 'yourdfpy' package: pip install 'amble[urdf]'") from e
+    _check_document(path)
     try:
         return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
                                   build_collision_scene_graph=False, load_collision_meshes=False)
@@ -95,20 +101,78 @@ def _read(path: Path) -> Any:
         raise ModelError(f"URDF {path.name}: cannot be read: {e}") from e
 
 
+def _check_document(path: Path) -> None:
+    """:class:`ModelError` for a file that is not well-formed XML (a truncated file, a NUL byte)
+    or whose elements contradict each other: two links or two joints of one name, a ``<mimic>``
+    naming no joint of the file.
+
+    The parser falls back to a recovering parse when the strict one fails, which reads a file
+    cut short or holding a NUL byte as if the missing or unreadable elements had never been
+    there (a robot with fewer links and no complaint); it also keeps one of two links of the same
+    name. So the file is parsed strictly here first."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise ModelError(f"URDF {path.name}: cannot be read ({e.strerror or e})") from None
+    nul = data.find(b"\0")
+    if nul >= 0:
+        line = data.count(b"\n", 0, nul) + 1
+        raise ModelError(f"URDF {path.name}: NUL byte at line {line} (byte {nul}): not a text file")
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError as e:
+        line, col = e.position
+        raise ModelError(f"URDF {path.name}: not well-formed XML at line {line}, column {col + 1} "
+                         f"({str(e).split(':')[0]}): is the file complete?") from None
+    for kind in ("link", "joint"):
+        seen: set[str] = set()
+        for el in root.findall(kind):
+            name = el.get("name")
+            if name in seen:
+                raise ModelError(f"URDF {path.name}: two {kind}s named {name!r}")
+            seen.add(name)
+    joints = {el.get("name") for el in root.findall("joint")}
+    for el in root.findall("joint"):
+        for mimic in el.findall("mimic"):
+            target = mimic.get("joint")
+            if target not in joints:
+                raise ModelError(f"URDF joint {el.get('name')!r}: <mimic> names joint {target!r}, "
+                                 "which the file does not declare")
+
+
+def _check_moments(name: str, moments: np.ndarray) -> None:
+    """The triangle inequality of a rigid body's principal moments of inertia: each at most the
+    sum of the other two (``I_x + I_y = ∫ (x² + y² + 2 z²) dm ≥ I_z``), up to a relative 1e-9 so
+    that an inertia rounded when written (a thin rod, a flat plate) still passes."""
+    largest, total = float(moments.max()), float(moments.sum())
+    tol = 1e-9 * float(np.abs(moments).sum())
+    if largest > total - largest + tol:
+        raise ModelError(f"URDF link {name!r}: principal moments of inertia "
+                         f"{', '.join(f'{v:g}' for v in moments)} violate the triangle inequality "
+                         "(each must be at most the sum of the other two): no rigid body has them")
+
+
 def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
     """Mass, centre of mass (link frame) and inertia about it (link axes) of a link."""
     ine = link.inertial
     mass = float(ine.mass) if ine.mass is not None else 0.0
+    if not math.isfinite(mass):
+        raise ModelError(f"URDF link {link.name!r}: mass {mass:g} is not finite")
     if not mass >= 0.0:
         raise ModelError(f"URDF link {link.name!r}: negative mass {mass:g}")
     T = np.eye(4) if ine.origin is None else np.asarray(ine.origin, dtype=float)
     I = np.zeros((3, 3)) if ine.inertia is None else np.asarray(ine.inertia, dtype=float)
+    if not np.isfinite(I).all() or not np.isfinite(T).all():
+        raise ModelError(f"URDF link {link.name!r}: inertial has a non-finite number")
     if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
         raise ModelError(f"URDF link {link.name!r}: inertia tensor is not symmetric")
     ev = np.linalg.eigvalsh(I)
     if mass > 0 and not ev.min() > 0:
         raise ModelError(f"URDF link {link.name!r}: inertia tensor is not positive definite "
                          f"(eigenvalues {', '.join(f'{v:g}' for v in ev)})")
+    _check_moments(link.name, ev)
     Rc = T[:3, :3]
     return mass, T[:3, 3].copy(), Rc @ I @ Rc.T
 

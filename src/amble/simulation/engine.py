@@ -20,7 +20,9 @@ from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, 
 from ..backend.kernels import Kernels
 from ..errors import StateError
 
-#: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB.
+#: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB. The
+#: buffers are what the trajectory holds (a grown buffer is handed over cut, not copied), so
+#: this bounds the growth of the process's peak memory by the recording too.
 RECORD_BUDGET = 512 * 2**20
 
 #: Integrators, in the order of the compiled loop's IO_METHOD codes.
@@ -366,19 +368,33 @@ class _Buffers:
         self._addresses = self.addresses()
 
     def result_and_release(self) -> dict[str, Any]:
-        """Copies of the recorded rows; the buffers go back to this thread's free ones if they
-        never grew."""
+        """The recorded rows: copies if the buffers never grew (they go back to this thread's free
+        ones), else the buffers themselves cut to the rows in place.
+
+        A grown buffer is held by nothing else, and a copy of it would double what the run holds
+        at its largest (the buffers and the copies, both up to ``budget`` bytes, alive at once):
+        the budget then bounds the process's memory, not only the buffers'."""
         if self is _NO_RECORDING:
             return _EMPTY
         n, ne = self._counts[0][0], self._counts[1][0]
+        names = ("t", "mode", "x", "et", "etr", "epre", "epost")
+        if (self.cap, self.ecap, self.nxm) != self._shape:
+            out = {name: _cut(getattr(self, name), n if name in ("t", "mode", "x") else ne) for name in names}
+            self.cap = self.ecap = 0  # the arrays now belong to the caller
+            return out
         out = {"t": self.t[:n].copy(), "mode": self.mode[:n].copy(), "x": self.x[:n].copy(),
                "et": self.et[:ne].copy(), "etr": self.etr[:ne].copy(), "epre": self.epre[:ne].copy(),
                "epost": self.epost[:ne].copy()}
-        if (self.cap, self.ecap, self.nxm) == self._shape:
-            if not hasattr(_FREE, "buffers"):
-                _FREE.buffers = {}
-            _FREE.buffers[self._shape] = self
+        if not hasattr(_FREE, "buffers"):
+            _FREE.buffers = {}
+        _FREE.buffers[self._shape] = self
         return out
+
+
+def _cut(a: np.ndarray, rows: int) -> np.ndarray:
+    """``a`` cut to its first ``rows`` rows in place (``realloc``: shrinking moves no data)."""
+    a.resize((rows,) + a.shape[1:], refcheck=False)
+    return a
 
 
 #: Buffers of every run that records nothing, shared: with both capacities 0 the compiled loop

@@ -150,8 +150,9 @@ def simulate(
         ``False``: record events only (the trajectory's rows are then the initial and the final
         state) — constant memory however long the run.
     budget:
-        Bytes the recording may take (default 512 MiB); a run that would record more ends as
-        ``record_limit`` with what it has.
+        Bytes the recording may take (default 512 MiB): the sample and event buffers, which
+        the trajectory then holds without a copy (so the process's peak memory grows by about
+        this much at most); a run that would record more ends as ``record_limit`` with what it has.
     method:
         ``"dop853"`` (explicit, the default) or ``"radau"`` (implicit Radau IIA with the model's
         exact Jacobian, for stiff systems); default that of ``options``.
