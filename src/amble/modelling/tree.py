@@ -32,6 +32,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .defs import Defs
+from .text import expr_of
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "spherical", "floating")
 #: the one-axis joints a spherical or floating joint stands for (suffix of the coordinate, type, axis):
@@ -194,7 +195,9 @@ class RigidTree:
             joint = Joint(kind, axis=axis, lower=joint.lower, upper=joint.upper,
                           post_xyz=joint.post_xyz, post_rotation=joint.post_rotation)
             coordinate = f"{cname}_{suffix}"
-        return self._add(name, parent, joint, mass, com, inertia, coordinate, unit)
+        body = self._add(name, parent, joint, mass, com, inertia, coordinate, unit)
+        self.model.touch()  # the tree is part of its model's declaration: a built system sees the body
+        return body
 
     def _add(self, name: str, parent: str | None, joint: Joint, mass: Any, com: Sequence[Any], inertia: Any,
              coordinate: str | None, unit: str | None, internal: bool = False) -> Body:
@@ -206,7 +209,8 @@ class RigidTree:
             if parent not in self._by_name:
                 raise ModelError(f"model {m.name!r}: body {name!r} hangs from unknown body {parent!r}")
             par = self._by_name[parent]
-        mass_e = _num(mass) if isinstance(mass, (int, float)) else sp.sympify(mass)
+        mass_e = (_num(mass) if isinstance(mass, (int, float))
+                  else expr_of(mass, m.symbol_table(), what=f"model {m.name!r}: mass of body {name!r}"))
         m._check_symbols(mass_e, f"mass of body {name!r}")
         b = Body(name=name, parent=par, joint=joint, mass=mass_e, com=_vec(com), inertia=_mat3(inertia))
         if b.com.shape != (3, 1):
