@@ -177,25 +177,11 @@ def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
     return mass, T[:3, 3].copy(), Rc @ I @ Rc.T
 
 
-def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
-                name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
-                base_joint: Joint | None = None, base_coordinate: str = "base",
-                parameters: bool | Collection[str] = False, pivot: str | None = None) -> Any:
-    """A model (of class ``cls``, a :class:`~amble.modelling.model.Model`) of the URDF at ``path``
-    with ``base`` fixed to the world (default: the URDF's root link), or attached to it by
-    ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``;
-    ``parameters``: which numbers become named model parameters (module docstring); ``pivot``:
-    a contact point on the base link where ``base_joint`` is centred (a point foot pivoting at
-    its sole) instead of the link's origin."""
-    path = Path(path)
-    if pivot is not None:
-        spec = (contact_points or {}).get(pivot)
-        if base_joint is None or spec is None or spec[0] != (base or spec[0]):
-            raise ModelError(f"pivot {pivot!r}: give a base_joint and a contact point of that name on the base link")
-        if base_joint.post_xyz is not None:
-            raise ModelError(f"pivot {pivot!r}: the base joint has an offset after its motion already")
-        base_joint = dataclasses.replace(base_joint, post_xyz=tuple(-float(v) for v in spec[1]))
-    robot = _read(path).robot
+def _tree_order(robot: Any, base: str | None, path: Path) -> tuple[dict[str, Any], str, list[tuple]]:
+    """The URDF's links by name, the base link and the links in breadth-first order from it, each
+    as ``(link, parent link or None at the base, joint, forward)`` (``forward``: the joint is
+    traversed from its parent to its child). Unsupported joints, unknown links, loops, several
+    roots and links not connected to the base are :class:`ModelError`."""
     links = {lk.name: lk for lk in robot.links}
     joints = list(robot.joints)
     for j in joints:
@@ -240,7 +226,29 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
     missing = [lk for lk in links if lk not in seen]
     if missing:
         raise ModelError(f"URDF {path.name}: links not connected to {base!r}: {', '.join(missing)}")
+    return links, base, order
 
+
+def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
+                name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
+                base_joint: Joint | None = None, base_coordinate: str = "base",
+                parameters: bool | Collection[str] = False, pivot: str | None = None) -> Any:
+    """A model (of class ``cls``, a :class:`~amble.modelling.model.Model`) of the URDF at ``path``
+    with ``base`` fixed to the world (default: the URDF's root link), or attached to it by
+    ``base_joint`` (e.g. a revolute pivot at a point foot) with the coordinate ``base_coordinate``;
+    ``parameters``: which numbers become named model parameters (module docstring); ``pivot``:
+    a contact point on the base link where ``base_joint`` is centred (a point foot pivoting at
+    its sole) instead of the link's origin."""
+    path = Path(path)
+    if pivot is not None:
+        spec = (contact_points or {}).get(pivot)
+        if base_joint is None or spec is None or spec[0] != (base or spec[0]):
+            raise ModelError(f"pivot {pivot!r}: give a base_joint and a contact point of that name on the base link")
+        if base_joint.post_xyz is not None:
+            raise ModelError(f"pivot {pivot!r}: the base joint has an offset after its motion already")
+        base_joint = dataclasses.replace(base_joint, post_xyz=tuple(-float(v) for v in spec[1]))
+    robot = _read(path).robot
+    links, base, order = _tree_order(robot, base, path)
     for lk in links.values():  # every inertial is checked, the base's too (nothing is silently dropped)
         if lk.inertial is not None:
             _check_inertial(lk)
