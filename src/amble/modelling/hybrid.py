@@ -156,10 +156,11 @@ class HybridSystem(Revised):
         hit_guard, lift = Guard(gap, -1), Guard(force, -1)
         self._check_guard(free, hit_guard)
         rest_model = self.modes[rest]
-        if sp.sympify(force).free_symbols & (set(rest_model.q) | set(rest_model.qd)):
+        force = expr_of(force, rest_model.symbol_table(), what=f"system {self.name!r}: contact force of {name!r}")
+        if force.free_symbols & (set(rest_model.q) | set(rest_model.qd)):
             self._check_guard(rest, lift)
         else:  # a force of the parameters and time only (a point on a fixed floor: its weight)
-            bad = sorted(str(s_) for s_ in sp.sympify(force).free_symbols - set(rest_model.params) - {_TIME})
+            bad = sorted(str(s_) for s_ in force.free_symbols - set(rest_model.params) - {_TIME})
             if bad:
                 raise ModelError(f"system {self.name!r}: the contact force of {name!r} uses unknown symbols "
                                  f"{', '.join(bad)}")

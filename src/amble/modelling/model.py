@@ -35,6 +35,7 @@ from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
 from .geometry import t
 from .revision import declaration
+from .text import expr_of
 from .tree import RigidTree
 
 
@@ -81,7 +82,8 @@ class Model(Actuators):
                     if pos is expr and name in self.tree.point_velocities:
                         return self.tree.point_velocities[name]
             return expr.applyfunc(self.dt)
-        expr = sp.sympify(expr)
+        if not isinstance(expr, sp.Basic):  # text or a number (this runs often: sympy values pass as they are)
+            expr = expr_of(expr, self.symbol_table(), what=f"model {self.name!r}: dt")
         out = self.diff(expr, t)
         for qi, vi in zip(self.q, self.qd):
             d = self.diff(expr, qi)
@@ -329,7 +331,8 @@ class Model(Actuators):
         A rigid-body tree stays one (:mod:`amble.modelling.constrained_tree`): its equations are
         the source tree's, projected.
         """
-        subs = {sp.sympify(k): sp.sympify(v) for k, v in substitutions.items()}
+        table, what = self.symbol_table(), f"model {self.name!r}: constrained {name!r}"
+        subs = {expr_of(k, table, what=what): expr_of(v, table, what=what) for k, v in substitutions.items()}
         for k in subs:
             if k not in self.q:
                 raise ModelError(f"model {self.name!r}: {k} is not a coordinate and cannot be eliminated")
