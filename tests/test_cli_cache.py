@@ -85,7 +85,8 @@ def test_a_dry_run_says_what_would_go_and_removes_nothing(empty_cache, capsys):
     d = empty_cache
     d.mkdir(mode=0o700)
     stale = d / f"{'a' * 24}.json"  # a record of a library that is gone, from long ago
-    stale.write_text(json.dumps({"name": "old-model", "library": f"{'a' * 24}-{'0' * 16}.so", "derivatives": True}))
+    stale.write_text(json.dumps({"name": "old-model", "library": f"{'a' * 24}-{'0' * 16}.so", "derivatives": True,
+                                 "library_sha256": "0" * 64}))
     os.utime(stale, (1e9, 1e9))
     code, text, _ = run(capsys, "cache", "clear", "--older-than", "30", "--dry-run")
     assert code == 0 and stale.exists()

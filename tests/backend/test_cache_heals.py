@@ -13,7 +13,7 @@ import warnings
 import pytest
 
 from amble import Guard, HybridSystem, Model
-from amble.backend import cache, kernels
+from amble.backend import cache, cache_home, kernels
 from amble.errors import CompileError
 
 _WALK = """
@@ -74,16 +74,23 @@ def test_the_model_name_is_never_a_path(tmp_path, monkeypatch):
 
 
 def test_builds_a_killed_compile_left_are_removed(tmp_path, monkeypatch):
+    """A killed compile's build directory (marked amble's before anything was written into it)
+    goes once it is old; a running one's stays, and so does a user's ``build-release``."""
     monkeypatch.setenv("AMBLE_CACHE_DIR", str(tmp_path))
-    old, fresh = tmp_path / "build-old", tmp_path / "build-fresh"
-    for d in (old, fresh):
+    assert cache.cache_dir() == tmp_path  # an empty directory: tagged a cache
+    old, fresh, user = tmp_path / "build-old_1234", tmp_path / "build-fresh123", tmp_path / "build-release"
+    for d in (old, fresh, user):
         d.mkdir()
         (d / "model.c").write_text("/* half written */")
+    for d in (old, fresh):
+        (d / cache_home.BUILD_MARKER).write_bytes(b"")
     past = time.time() - 2 * cache.ORPHAN_AGE
-    os.utime(old, (past, past))
+    for d in (old, user):
+        os.utime(d, (past, past))
     s = _pendulum("orphans")
     cache.rebuild(s, kernels.structure_key(s))
     assert not old.exists() and fresh.exists()  # a build still running elsewhere is left alone
+    assert (user / "model.c").read_text() == "/* half written */"
 
 
 @pytest.mark.parametrize("why", ["world-writable", "a file"])
@@ -95,7 +102,7 @@ def test_an_unusable_cache_falls_back_to_a_private_one(tmp_path, monkeypatch, wh
         bad.mkdir()
         bad.chmod(0o777)
     monkeypatch.setenv("AMBLE_CACHE_DIR", str(bad))
-    monkeypatch.setattr(cache, "_FALLBACK", {})
+    monkeypatch.setattr(cache_home, "_FALLBACK", {})
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = cache.cache_dir()

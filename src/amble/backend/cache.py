@@ -27,10 +27,12 @@ The cache heals and cannot be steered:
 * ``<key>.json`` names the library and holds its SHA-256; the library is loaded only if its bytes
   match (a truncated, planted or foreign file is never loaded — it is rebuilt);
 * every file is written to a temporary name and renamed into place, so concurrent processes (Dask
-  workers) can build the same model; build directories a killed compile left behind are removed;
-* the directory is created private (0700) and refused if another user owns it or others may
-  write to it; a cache that cannot be used (read-only, a file, no home) falls back to a private
-  temporary one for the process, with one warning.
+  workers) can build the same model; build directories a killed compile left behind are removed,
+  and nothing else: only what amble can prove it wrote (:mod:`amble.backend.cache_home`);
+* the directory is created private (0700), tagged as a cache (``CACHEDIR.TAG``) and refused if
+  another user owns it, others may write to it, or it is not a cache (a folder of the user's
+  files); a cache that cannot be used falls back to one private directory per user, with one
+  warning.
 
 Every library links the model-independent runtime (the event loop, the implicit integrator,
 sensitivities, batches: :mod:`amble.backend.runtime`), compiled once per capacity bucket and
@@ -39,7 +41,7 @@ its SHA-256; it heals in the same way (a damaged object is rebuilt). A library's
 runtime's: the engine sources and the toolchain are in both, and the capacity follows from the
 structure.
 
-The cache lives in ``$AMBLE_CACHE_DIR``, else ``$XDG_CACHE_HOME/amble``, else
+The cache lives in ``$AMBLE_CACHE_DIR`` (made absolute), else ``$XDG_CACHE_HOME/amble``, else
 ``~/.cache/amble``. ``$CC`` picks the C compiler (default ``cc``); a C99 compiler is the one
 system requirement of amble.
 """
@@ -49,7 +51,6 @@ from __future__ import annotations
 import json
 import os
 import time
-import warnings
 import weakref
 from functools import lru_cache
 from pathlib import Path
@@ -58,6 +59,9 @@ from typing import TYPE_CHECKING, Any
 from ..errors import CompileError
 from ..version import __version__
 from . import host
+from .cache_home import CacheWarning as CacheWarning  # re-exported: where the cache lives is asked of this module
+from .cache_home import build_directory, cache_dir, is_build, is_writing
+from .cache_home import configured as configured
 from .digest import sha256
 from .files import sha256_of, write_atomic
 from .units import run_compilers, split_units
@@ -81,72 +85,10 @@ _SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/*.py")
 _STRUCT: dict[int, tuple[weakref.ref, tuple, str]] = {}
 
 
-#: Build directories and temporary files (:func:`is_temporary`) older than this (s) belong to a
-#: compile that was killed; younger ones may be a build in progress.
+#: Build directories and half-written files (:func:`~amble.backend.cache_home.is_build`,
+#: :func:`~amble.backend.cache_home.is_writing`) older than this (s) belong to a compile that was
+#: killed; younger ones may be a build in progress.
 ORPHAN_AGE = 3600.0
-_FALLBACK: dict[str, Path] = {}
-
-
-class CacheWarning(UserWarning):
-    """The configured cache directory cannot be used; a private temporary one is used instead."""
-
-
-def is_temporary(name: str) -> bool:
-    """Whether a file name in the cache is a build's working directory or a file being written."""
-    return name.startswith("build-") or (name.startswith(".") and name.endswith(".tmp"))
-
-
-def configured() -> tuple[Path, str | None]:
-    """The configured cache directory and why it cannot be used (``None`` if it can; it is
-    created private if missing)."""
-    try:
-        d = _configured_dir()
-    except RuntimeError as e:  # Path.home() without a home
-        return Path("~"), f"no home directory ({e})"
-    return d, _unusable(d)
-
-
-def _configured_dir() -> Path:
-    env = os.environ.get("AMBLE_CACHE_DIR")
-    if env:
-        return Path(env)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return Path(xdg) / "amble" if xdg else Path.home() / ".cache" / "amble"
-
-
-def _unusable(d: Path) -> str | None:
-    """Why ``d`` cannot serve as a cache (after trying to create it private), or ``None``."""
-    try:
-        d.mkdir(mode=0o700, parents=True, exist_ok=True)
-    except OSError as e:
-        return f"cannot create it ({e.strerror or e})"
-    if not d.is_dir():
-        return "it is not a directory"
-    st = d.stat()
-    if hasattr(os, "getuid") and st.st_uid != os.getuid():
-        return "another user owns it"
-    if st.st_mode & 0o022:
-        return "other users may write to it"
-    if not os.access(d, os.W_OK | os.X_OK):
-        return "it is not writable"
-    return None
-
-
-def cache_dir() -> Path:
-    """The cache directory: the configured one if it is usable (see the module docstring), else a
-    private temporary directory for this process (with a :class:`CacheWarning`)."""
-    d, why = configured()
-    if why is None:
-        return d
-    key = str(d)
-    if key not in _FALLBACK:
-        import tempfile
-
-        _FALLBACK[key] = Path(tempfile.mkdtemp(prefix="amble-cache-"))
-        warnings.warn(f"amble: cache {d} is not usable ({why}); compiling into {_FALLBACK[key]} for this process",
-                      CacheWarning, stacklevel=2)
-    return _FALLBACK[key]
-
 
 def source_files() -> list[Path]:
     """The C engine and the Python sources that generate a library."""
@@ -343,7 +285,9 @@ def rebuild(system: HybridSystem, key: str, d: Path | None = None, derivatives: 
 
 
 def _remove_orphans(d: Path) -> None:
-    """Remove build directories and temporary files that a killed process left behind."""
+    """Remove what a killed compile of amble's left behind in ``d``: its build directories
+    (:func:`~amble.backend.cache_home.is_build`) and half-written entries, once older than
+    :data:`ORPHAN_AGE`. Nothing else is touched, whatever its name."""
     import shutil
 
     now = time.time()
@@ -351,10 +295,10 @@ def _remove_orphans(d: Path) -> None:
         names = os.listdir(d)
     except OSError:
         return
-    for p in [d / n for n in names if is_temporary(n)]:
+    for p in [d / n for n in names if is_writing(n) or is_build(d / n)]:
         try:
-            if now - p.stat().st_mtime > ORPHAN_AGE:
-                shutil.rmtree(p) if p.is_dir() else p.unlink()
+            if now - p.lstat().st_mtime > ORPHAN_AGE:
+                shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
         except OSError:
             pass
 
@@ -368,21 +312,19 @@ def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
     its own unit (:func:`split_units`) is compiled as two units at once and linked: the largest
     kernel of a big tree model takes as long as everything else together, so on two cores the
     wall time nearly halves."""
-    import tempfile
-
     from . import runtime
 
     cc = compiler()
     cap = runtime.capacity_of(src)
     linked = [] if cap is None else [str(runtime.runtime_object(d, cap, runtime_toolchain()))]
-    with tempfile.TemporaryDirectory(prefix="build-", dir=d) as tmpd:
-        out = Path(tmpd) / "model.so"
+    with build_directory(d) as tmpd:
+        out = tmpd / "model.so"
         base = [*cc.split(), *cflags(), "-std=c99", "-Werror=implicit-function-declaration", "-fPIC"]
         main, own = split_units(src)
         units = [main] if own is None else [main, own]
         files = []
         for i, text in enumerate(units):
-            files.append(Path(tmpd) / f"model{i or ''}.c")
+            files.append(tmpd / f"model{i or ''}.c")
             files[-1].write_text(text)
         if own is None:
             run_compilers([[*base, "-shared", "-I", str(C_DIR), str(files[0]), *linked, "-o", str(out), "-lm"]], cc)

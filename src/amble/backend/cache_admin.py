@@ -10,12 +10,14 @@ The cache directory (:mod:`amble.backend.cache`) holds
   ``runtime-<key>-<sha>.o``, one per capacity and toolchain;
 * warm-start index entries ``index-<id>.json``, each naming the library key of one model source
   (:mod:`amble.backend.index`), and stamps ``stamp-<id>.json`` (:mod:`amble.backend.stamps`);
-* the temporaries of builds: ``build-*`` directories of a compile and ``.<name>.<pid>.tmp`` files
-  of an atomic write (:func:`amble.backend.files.write_atomic`).
+* the temporaries of builds: ``build-*`` directories of a compile (marked as amble's) and
+  ``.<name>.<pid>.tmp`` files of an atomic write (:func:`amble.backend.files.write_atomic`);
+* its tag, ``CACHEDIR.TAG`` (:mod:`amble.backend.cache_home`): a directory without one is not
+  listed or cleared. Anything else in it is the user's and never removed.
 
 Builds take no lock: several processes may build into one directory, each writing under temporary
 names and renaming into place, and a temporary older than the cache's orphan age is a killed
-build's (:func:`amble.backend.cache.is_temporary`, :data:`~amble.backend.cache.ORPHAN_AGE`). The
+build's (:func:`amble.backend.cache_home.is_build`, :data:`~amble.backend.cache.ORPHAN_AGE`). The
 same marks tell this module that a build is in progress, and removal
 (:mod:`amble.backend.cache_clear`) keeps what a build may be using.
 
@@ -29,7 +31,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -37,11 +38,9 @@ from typing import Any
 
 from ..errors import AmbleError, CompileError
 from . import cache
+from .cache_home import ENTRY_NAMES, TAG, entry_kind, is_amble_name, is_build, is_writing
 
-_MODEL = re.compile(r"([0-9a-f]{24})(?:-[0-9a-f]{16}\.(?:so|c)|\.json)")
-_RUNTIME = re.compile(r"runtime-([0-9a-f]{24})(?:-[0-9a-f]{16}\.o|\.json)")
-_INDEX = re.compile(r"index-[0-9a-f]{32}\.json")
-_STAMP = re.compile(r"stamp-[0-9a-f]{32}\.json")
+_MODEL, _RUNTIME = ENTRY_NAMES["model"], ENTRY_NAMES["runtime"]
 
 
 class CacheRequestError(AmbleError, ValueError):
@@ -137,17 +136,22 @@ def scan(d: Path | None = None) -> Contents:
         names = sorted(os.listdir(d))
     except FileNotFoundError:
         return out
+    if TAG not in names:  # what is not a cache is never listed as one, let alone cleared
+        raise CacheRequestError(f"{d} is not an amble cache (it has no {TAG})")
     for n in names:
         p = d / n
-        if cache.is_temporary(n):
+        kind = entry_kind(n)
+        if kind and n.endswith(".json") and not is_amble_name(d, n):
+            kind = None  # named like a record but not one amble wrote (a rewrite heals a damaged one)
+        if is_writing(n) or is_build(p):
             out.temporaries.append(_single("temporary", p))
-        elif m := _RUNTIME.fullmatch(n):
+        elif kind == "runtime" and (m := _RUNTIME.fullmatch(n)):
             groups.setdefault(("runtime", m[1]), []).append(p)
-        elif m := _MODEL.fullmatch(n):
+        elif kind == "model" and (m := _MODEL.fullmatch(n)):
             groups.setdefault(("model", m[1]), []).append(p)
-        elif _INDEX.fullmatch(n) or _STAMP.fullmatch(n):
-            (out.index if n.startswith("index-") else out.stamps).append(_single(n.split("-")[0], p))
-        else:
+        elif kind in ("index", "stamp"):
+            (out.index if kind == "index" else out.stamps).append(_single(kind, p))
+        elif n != TAG:
             out.other.append(p)
     specs = _specs(out.index)
     out.index = [replace(e, name=hit[0]) if (hit := index_library(e)) else e for e in out.index]
@@ -245,7 +249,7 @@ def info(d: Path | None = None) -> dict[str, Any]:
     if why is not None:
         out["reason"] = why
     c = scan(d) if why is None else Contents(d)
-    other = sum(s.st_size for s in map(lstat, c.other) if s is not None)
+    other = sum(s.st_size for s in map(lstat, [*c.other, d / TAG]) if s is not None)
     out.update(models=len(c.models), runtimes=len(c.runtimes), index_entries=len(c.index), stamps=len(c.stamps),
                builds_in_progress=len(building(c)), other_files=len(c.other),
                bytes=sum(e.bytes for e in c.entries()) + other)

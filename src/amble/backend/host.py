@@ -14,12 +14,18 @@ kind of processor instead of handing one machine's instructions to another.
 
 ``$AMBLE_CFLAGS`` replaces the flags (e.g. ``-O2`` for code any x86-64 runs, or to profile under
 valgrind, which does not decode every AVX-512 instruction). A compiler that refuses
-``-march=native`` compiles without it.
+``-march=native`` compiles without it. Flags that let the compiler assume no NaN or infinity
+occurs (``-ffast-math``, ``-Ofast``, ``-ffinite-math-only``, clang's ``-fno-honor-nans`` and
+``-fno-honor-infinities``) would compile away the checks that end a run whose state is no longer
+finite (status ``integrator_failure``) and make it run on with NaNs: they are neutralised —
+``-fno-finite-math-only`` (and ``-fhonor-…``) appended, so the rest of what was asked for still
+applies — with one :class:`FlagsWarning` per process.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from functools import lru_cache
 
 #: The flags of a build when ``$AMBLE_CFLAGS`` is not set.
@@ -28,6 +34,24 @@ DEFAULT_CFLAGS = "-O2 -march=native -ffp-contract=off"
 #: Lines of ``/proc/cpuinfo`` that identify what instructions a processor has.
 _CPU_FIELDS = ("vendor_id", "cpu family", "model", "model name", "flags", "features", "cpu implementer",
                "cpu architecture", "cpu variant", "cpu part")
+
+
+#: Flags that let the compiler assume every value finite, and the flags that undo that (appended).
+_FINITE_ONLY = {"-ffast-math": "-fno-finite-math-only", "-Ofast": "-fno-finite-math-only",
+                "-ffinite-math-only": "-fno-finite-math-only",
+                "-fno-honor-nans": "-fhonor-nans", "-fno-honor-infinities": "-fhonor-infinities"}
+
+
+class FlagsWarning(UserWarning):
+    """``$AMBLE_CFLAGS`` asked for something amble cannot run with, and was changed."""
+
+
+def ieee(flags: list[str]) -> tuple[list[str], list[str]]:
+    """``flags`` with every assumption of finite values undone (see the module docstring), and
+    the flags that asked for it (empty: unchanged)."""
+    asked = [f for f in flags if f in _FINITE_ONLY]
+    undo = list(dict.fromkeys(_FINITE_ONLY[f] for f in asked))
+    return ([*flags, *undo] if asked else flags), asked
 
 
 def flags_setting() -> str:
@@ -44,17 +68,29 @@ def setting_of(flags: str | None) -> str:
 @lru_cache(maxsize=8)
 def _setting(flags: str) -> str:
     # one string object per setting: the keys' caches hash it once, not a kilobyte per build()
+    flags = " ".join(ieee(flags.split())[0])  # the flags compiled with, not the ones asked for
     return f"{flags}\0{cpu_identity()}" if "native" in flags else flags
 
 
 def cflags(cc: str) -> list[str]:
-    """The flags to compile with, for compiler command ``cc``: the setting, without its ``native``
-    options if ``cc`` does not accept them."""
-    flags = os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS).split()
+    """The flags to compile with, for compiler command ``cc``: the setting with IEEE semantics
+    restored (see the module docstring), without its ``native`` options if ``cc`` does not
+    accept them."""
+    given = os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS).split()
+    flags, asked = ieee(given)
+    if asked:
+        _warn_once(" ".join(asked), " ".join(flags[len(given):]))
     native = [f for f in flags if f.endswith("=native")]
     if native and not _accepts(cc, tuple(native)):
         flags = [f for f in flags if f not in native]
     return flags
+
+
+@lru_cache(maxsize=8)
+def _warn_once(asked: str, added: str) -> None:
+    warnings.warn(f"amble: AMBLE_CFLAGS {asked} would let the compiler assume no NaN or infinity and compile "
+                  f"away the checks of a state that is no longer finite; compiling with {added} appended",
+                  FlagsWarning, stacklevel=4)
 
 
 @lru_cache(maxsize=1)

@@ -93,7 +93,7 @@ def lookup(spec: str, sources: Sequence[Path], loader: Callable[[], HybridSystem
     try:
         d = cache.cache_dir()
         path = entry_path(spec, sources, d)
-        text = path.read_text()
+        text = path.read_bytes()  # parsed below: bytes that are not UTF-8 are an unreadable entry
     except OSError:  # no entry (the usual miss), or a source that cannot be read
         return None
     try:

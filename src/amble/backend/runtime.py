@@ -33,6 +33,7 @@ from typing import NamedTuple
 
 from ..errors import CompileError
 from . import abi
+from .cache_home import build_directory
 from .digest import sha256
 from .files import sha256_of, write_atomic
 from .units import run_compilers
@@ -117,13 +118,12 @@ def runtime_object(d: Path, cap: int, tc: Toolchain) -> Path:
 
 def build(d: Path, cap: int, tc: Toolchain) -> Path:
     """Compile the runtime of capacity ``cap`` into ``d`` and record it (replacing any entry)."""
-    import tempfile
-
     global COMPILES
     key, cc = runtime_key(cap, tc), tc.cc
-    with tempfile.TemporaryDirectory(prefix="build-", dir=d) as tmpd:
-        (Path(tmpd) / "amble_abi.h").write_text(abi.c_header())
-        out = Path(tmpd) / "runtime.o"
+    with build_directory(d) as work:
+        tmpd = str(work)
+        (work / "amble_abi.h").write_text(abi.c_header())
+        out = work / "runtime.o"
         cmd = [*cc.split(), *tc.flags, "-std=c99", "-Werror=implicit-function-declaration", "-fPIC",
                f"-D{CAPACITY_MACRO}={cap}", "-I", tmpd, "-I", str(C_DIR), "-c", str(C_DIR / "runtime.c"),
                "-o", str(out)]

@@ -35,7 +35,8 @@ def add_parser(add: Any) -> None:
                    "a build uses").set_defaults(func=cmd_info)
     action("list", "one row per compiled model library and per runtime object").set_defaults(func=cmd_list)
     clear = action("clear", "remove compiled libraries (with their index entries) and, with --all or "
-                            "--older-than, runtime objects; files of a build in progress are kept")
+                            "--older-than, runtime objects; files of a build in progress are kept, and only "
+                            "amble's own files are ever removed (a directory without amble's CACHEDIR.TAG is refused)")
     which = clear.add_mutually_exclusive_group(required=True)
     which.add_argument("--all", action="store_true", dest="everything", help="every entry")
     which.add_argument("--older-than", metavar="DAYS", dest="older_than",
