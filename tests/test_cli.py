@@ -1,4 +1,4 @@
-"""The command-line contract of DESIGN.md: JSON fields, exit codes, one-line errors."""
+"""The command-line contract: JSON fields, exit codes, one-line errors."""
 
 import json
 import subprocess

@@ -20,7 +20,7 @@ def pendulum(name: str, torque=None, g: float = 9.81) -> tuple[Model, sp.Symbol]
 
 
 def switching_pendulum(name: str = "ev-switching") -> HybridSystem:
-    """The issue's switching controller: τ = −20 if θ + 0.5 θ̇ > 0 else +20."""
+    """A switching controller: τ = −20 if θ + 0.5 θ̇ > 0 else +20."""
     m, _ = pendulum(name, lambda th, thd, _: sp.Piecewise((-20, th + 0.5 * thd > 0), (20, True)))
     return HybridSystem(name, m)
 

@@ -1,10 +1,10 @@
-"""Findings 2 and 4 of issue 15: footfalls and crossings are not decided by round-off.
+"""Footfalls and crossings are not decided by round-off.
 
-2. Legs passing each other put the swing foot on the slope "ahead" of the stance foot by 4e-17 m:
-   a zero-length heel strike (stance = swing) fired. A footfall now needs the foot ahead by a
-   margin scaled to the model's size.
-4. A guard exactly zero right after a reset never fired, even when the flow crossed it at once.
-   A crossing from zero is now decided by the sign of ġ.
+* Legs passing each other put the swing foot on the slope "ahead" of the stance foot by 4e-17 m:
+  a zero-length heel strike (stance = swing) fired. A footfall now needs the foot ahead by a
+  margin scaled to the model's size.
+* A guard exactly zero right after a reset never fired, even when the flow crossed it at once.
+  A crossing from zero is now decided by the sign of ġ.
 """
 
 import math
@@ -19,7 +19,7 @@ from amble.models import compass_gait
 
 def test_no_zero_length_heel_strike_when_the_legs_pass():
     s = compass_gait.build()
-    for slope in (-0.05, 0.02):  # the issue's two cases (t = 0.305 s and t = 1.877 s)
+    for slope in (-0.05, 0.02):  # legs passing each other at t = 0.305 s and t = 1.877 s
         tr = amble.simulate(s, params={"slope": slope}, steps=5)
         strikes = [e for e in tr.events if e.name == "heel_strike"]
         for e in strikes:
@@ -77,7 +77,7 @@ def test_a_guard_zero_after_a_reset_moving_away_fires_when_it_comes_back():
 
 @pytest.mark.parametrize("n", [pytest.param(12, id="12x12"), pytest.param(40, id="40x40", marks=pytest.mark.slow)])
 def test_compass_basin_equals_the_basin_with_an_explicit_margin(tmp_path, n):
-    # issue 15: with footfalls decided by round-off, ≈ 4 % of the converging cells of a basin
+    # with footfalls decided by round-off, ≈ 4 % of the converging cells of a basin
     # were "fell" (551 converge, 575 with a 1e-6 m margin); the default margin must flip no cell
     import numpy as np
 

@@ -1,4 +1,4 @@
-"""Finding 5 of issue 15: kinetic terms added with ``add_kinetic`` were silently left out of the
+"""Kinetic terms added with ``add_kinetic`` were silently left out of the
 derived impact (the compass hip written as ``add_kinetic(½ m_H |ṗ_hip|²)`` gave post-impact rates
 (0.982, 0.969) instead of (0.854, 0.500)). The expression cannot tell a translating mass from a
 rotational inertia, so an Impact now rejects such terms with a ModelError that says why; rotational

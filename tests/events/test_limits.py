@@ -1,4 +1,4 @@
-"""Finding 1 and 6 of issue 15: runs end. A cap on integrator steps between transitions and in
+"""Runs end. A cap on integrator steps between transitions and in
 total ends a run with a named status, a one-line message and the partial trajectory; Ctrl-C
 interrupts the compiled loop with the run so far attached to the KeyboardInterrupt."""
 

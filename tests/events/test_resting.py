@@ -1,4 +1,4 @@
-"""Finding 3 of issue 15 (partly): with restitution 0, or a ball released on the floor, the run
+"""With restitution 0, or a ball released on the floor, the run
 fell through the floor silently (z = −447 m, status end_time). A bounce written as a plain
 transition with an Explicit reset has no resting mode: the run ends at the floor as ``zeno`` (the
 impacts accumulate), at the closed-form landing time, instead of lying. Declared with

@@ -1,4 +1,4 @@
-"""Resting contact (issue 15): a unilateral contact declared with ``unilateral_contact`` bounces
+"""Resting contact: a unilateral contact declared with ``unilateral_contact`` bounces
 with restitution, comes to rest in its constrained mode when the impacts accumulate (or at once
 with e = 0), and lifts off when the contact force would turn negative. Closed forms: the Zeno
 time of a bouncing ball, free fall, and the force of a point held on a table."""

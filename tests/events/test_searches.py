@@ -1,4 +1,4 @@
-"""Findings 6 and 8 of issue 15: searches end and gaits are gaits. A fixed-point search on a
+"""Searches end and gaits are gaits. A fixed-point search on a
 system without a step transition ran forever; a period of 10⁶ ran past 180 s; a wheel at rest was
 a "stable period-1 gait" with step time 2e-8 s; a period-2 search returned the period-1 gait
 twice over as "period-2"."""

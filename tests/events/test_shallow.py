@@ -1,4 +1,4 @@
-"""Finding 7 of issue 15: a guard that dips just below zero inside an integration step was
+"""A guard that dips just below zero inside an integration step was
 missed — the screening on the cubic Hermite interpolant cannot see a dip of 1e-7, although the
 run is accurate to 1e-11. The extremum of the guard is now found on the 7th-order dense output:
 a dip deeper than the integration tolerance is a crossing, a true tangency stays a non-event."""

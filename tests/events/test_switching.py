@@ -1,4 +1,4 @@
-"""Finding 1 of issue 15: a force that switches (Piecewise, sign, …) made the integrator creep
+"""A force that switches (Piecewise, sign, …) made the integrator creep
 across the kink forever. Its switching surfaces are now events without a reset, and a flow that
 points into a surface from both sides ends the run as ``sliding`` (time and surface reported)."""
 

@@ -1,5 +1,7 @@
 """Kneed biped: impacts against conservation laws, walking, limit cycle, and Hsu Chen's published gait."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -147,16 +149,34 @@ def test_hsu_chen_published_fixed_point_is_that_of_her_euler_scheme(kneed):
     np.testing.assert_allclose(euler_stride(k, p, x0), x0, rtol=0, atol=1e-9)
 
 
+@functools.lru_cache(maxsize=None)
+def _oracle(slope: float, z0: tuple = (0.1877, -1.1014, -0.0399)) -> dict:
+    """Hsu Chen's walker integrated by SciPy from equations written out independently of amble
+    (tests/oracles/kneed_biped.py): her signs, post-heel-strike state [q1, q2, q3, q1', q2', q3']."""
+    from oracles.kneed_biped import limit_cycle
+
+    return limit_cycle(dict(HSU_CHEN, slope=slope), z0)
+
+
+def _hers_to_ours(x):
+    """Her full post-heel-strike state [q1, q2, q3, q1', q2', q3'] → ours (stance, shank, thigh, rates)."""
+    return -np.asarray(x)[[0, 2, 1, 3, 5, 4]]
+
+
 def test_hsu_chen_accurate_limit_cycle(kneed):
-    # Reference: docs/references.md 3a [R], an independent port of her dynamics and impact matrices
-    # integrated with DOP853 at 1e-12: [q1, q1', q2'] = [0.18816565, -1.10894729, -0.05771783],
-    # step 0.564578 s, eigenvalues 0.35314 ± 0.55211i, 0.14387.
+    # against her walker integrated by SciPy (DOP853 at 1e-12, Newton with central differences):
+    # [q1, q1', q2'] = [0.18816565, -1.10894729, -0.05771783], step 0.564578 s, multipliers
+    # 0.35314 ± 0.55211i and 0.14387 (docs/references.md 3a)
+    ref = _oracle(HSU_CHEN["slope"])
     lc = find_fixed_point(kneed, to_ours(HSU_CHEN_X0), params=HSU_CHEN)
     assert lc.residual < 1e-9 and lc.stable
-    np.testing.assert_allclose(lc.fixed_point[[0, 3, 4]], [-0.18816565, 1.10894729, 0.05771783], rtol=0, atol=2e-8)
-    assert lc.step_time == pytest.approx(0.564578, abs=1e-6)
-    mult = sorted(lc.multipliers, key=lambda z: (abs(z), z.imag))
-    np.testing.assert_allclose(np.array(mult), [0.14387, 0.35314 - 0.55211j, 0.35314 + 0.55211j], atol=1e-5)
+    np.testing.assert_allclose(lc.fixed_point, _hers_to_ours(ref["fixed_point"]), rtol=0, atol=1e-8)
+    assert lc.step_time == pytest.approx(ref["step_time"], abs=1e-8)
+    knee = next(e for e in lc.trajectory(steps=1).events if e.name == "knee_lock")
+    assert knee.t == pytest.approx(ref["knee_time"], abs=1e-8)
+    # the oracle's multipliers carry central-difference errors of ~1e-8
+    key = lambda z: (abs(z), z.imag)  # noqa: E731
+    np.testing.assert_allclose(sorted(lc.multipliers, key=key), sorted(ref["multipliers"], key=key), atol=1e-6)
     # the published (Euler, dt = 1e-3) numbers are off by 0.018 rad/s in the swing velocity
     assert np.max(np.abs(lc.fixed_point - to_ours(HSU_CHEN_X0))) == pytest.approx(0.0179, abs=5e-4)
 
@@ -188,10 +208,11 @@ def test_default_search_finds_the_stable_gait_at_hsu_chens_parameters(kneed, slo
     tr = simulate(kneed, lc.fixed_point + np.array([0.0, 0.0, 0.0, 0.02, -0.03, -0.03]), params=params, steps=40)
     assert tr.status == "completed"
     np.testing.assert_allclose(tr.final_post_impact_state, lc.fixed_point, atol=1e-5)
-    if slope == HSU_CHEN_SLOPES[0]:  # docs/references.md 3a [R]: the independent port, 0.564578 s
-        assert lc.step_time == pytest.approx(0.564578, abs=1e-6)
-    if slope == 0.06:  # not the unstable gait of 0.474 s, |μ| 3.60, that lies nearer the model's default gait
-        assert lc.step_time == pytest.approx(0.5754, abs=1e-3)
+    if slope in (HSU_CHEN_SLOPES[0], 0.06):  # the SciPy oracle's stable gait (tests/oracles/kneed_biped.py)
+        # at 0.06 not the unstable gait of 0.474 s, |μ| 3.60, that lies nearer the model's default gait
+        ref = _oracle(slope)
+        assert lc.step_time == pytest.approx(ref["step_time"], abs=1e-8)
+        np.testing.assert_allclose(lc.fixed_point, _hers_to_ours(ref["fixed_point"]), rtol=0, atol=1e-8)
 
 
 def test_an_explicit_guess_is_followed_even_to_an_unstable_gait(kneed):
@@ -199,5 +220,9 @@ def test_an_explicit_guess_is_followed_even_to_an_unstable_gait(kneed):
     # swap a cycle the caller asked for)
     guess = [-0.18746, 0.30746, 0.30746, 1.32788, 0.50149, 0.50149]
     lc = find_fixed_point(kneed, guess, params=dict(HSU_CHEN, slope=0.06))
-    assert not lc.stable and lc.step_time == pytest.approx(0.4744, abs=1e-3)
-    assert max(abs(lc.multipliers)) == pytest.approx(3.60, abs=0.01)
+    # the SciPy oracle's Newton from the same guess (her signs) finds the same unstable gait
+    ref = _oracle(0.06, (0.18746, -1.32788, -0.50149))
+    assert not lc.stable and lc.step_time == pytest.approx(ref["step_time"], abs=1e-8)
+    np.testing.assert_allclose(lc.fixed_point, _hers_to_ours(ref["fixed_point"]), rtol=0, atol=1e-8)
+    assert max(abs(lc.multipliers)) == pytest.approx(max(abs(ref["multipliers"])), rel=1e-6)
+    assert max(abs(lc.multipliers)) > 3  # ≈ 3.60

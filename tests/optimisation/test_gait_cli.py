@@ -80,7 +80,7 @@ def test_posture_has_the_models_coordinate_count(capsys, tmp_path):
 
 
 def test_rabbit_at_0_8_m_per_s_from_the_command_line(capfd, tmp_path):
-    """The issue's command on the library RABBIT with its naive default start (standing still)
+    """``optimize-gait`` on the library RABBIT with its naive default start (standing still)
     and, by default, its own virtual constraints: 0.8 m/s, feasible, the parameters for its
     controller in gait.json."""
     path = tmp_path / "gait.json"

@@ -3,8 +3,9 @@ periodic over the pair.
 
 Truth, independent of the collocation: for a symmetric robot whose one-step optimum is unique
 (the compass gait with hip and ankle torques at a fixed step length), the two-step optimum is two
-copies of it; the passive compass gait on a 4.6° slope — between its first (4.39°) and second
-(4.91°) period doublings (docs/references.md) — walks a period-2 gait of two different steps,
+copies of it; the passive compass gait on a 4.6° slope — between its first and second period doublings
+(4.37° and 4.9° printed by Goswami, Thuilot & Espiau; 4.391° and 4.914° re-computed,
+docs/references.md) — walks a period-2 gait of two different steps,
 which Newton on amble's exact return map over two steps (``find_fixed_point(period=2)``) finds.
 """
 
