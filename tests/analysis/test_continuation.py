@@ -1,6 +1,7 @@
 """Pseudo-arclength continuation: residuals, the compass gait's period doubling against the
 normal form of a flip fitted to brute-force period-2 orbits, against the 4.37° printed by Goswami,
-Thuilot & Espiau and against a SciPy re-computation of their equations (tests/oracles), the kneed biped's fold against brute-force existence, branch switching and the CLI kind."""
+Thuilot & Espiau and against a SciPy re-computation of their equations (tests/oracles), the
+kneed biped's fold against brute-force existence, branch switching and the CLI kind."""
 
 from __future__ import annotations
 

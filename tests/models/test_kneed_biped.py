@@ -149,7 +149,7 @@ def test_hsu_chen_published_fixed_point_is_that_of_her_euler_scheme(kneed):
     np.testing.assert_allclose(euler_stride(k, p, x0), x0, rtol=0, atol=1e-9)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _oracle(slope: float, z0: tuple = (0.1877, -1.1014, -0.0399)) -> dict:
     """Hsu Chen's walker integrated by SciPy from equations written out independently of amble
     (tests/oracles/kneed_biped.py): her signs, post-heel-strike state [q1, q2, q3, q1', q2', q3']."""

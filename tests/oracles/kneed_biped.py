@@ -19,7 +19,7 @@ Run as a script it prints the fixed point, step time and multipliers (a few seco
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import sympy as sp
@@ -30,7 +30,7 @@ PARAMS = dict(mh=0.5, mt=0.5, ms=0.05, a1=0.375, b1=0.125, a2=0.175, b2=0.325, g
 RTOL = ATOL = 1e-12
 
 
-@lru_cache(maxsize=None)
+@cache
 def _dynamics(locked: bool):
     """NumPy function (q, q', params) → q'' of the unlocked (3 coordinates) or locked (2) phase."""
     mh, mt, ms, a1, b1, a2, b2, g = sp.symbols("mh mt ms a1 b1 a2 b2 g", positive=True)

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -88,20 +89,66 @@ def clear(d: Path | None = None, *, everything: bool = False, older_than: float 
     start = time.time()
     c = admin.scan(d)
     marks = admin.building(c, start)
-    began = min((_began(e) for e in marks), default=math.inf) - _SLACK
     cutoff = start - older_than * _DAY if older_than is not None else math.inf
-    if everything:
-        models, runtimes = c.models, c.runtimes
-    elif older_than is not None:
-        models = [e for e in c.models if e.last_used < cutoff]
-        runtimes = [e for e in c.runtimes if e.last_used < cutoff]
-    else:
-        models, runtimes = [e for e in c.models if model in (e.name, *e.specs)], []
-        if not models:
-            raise CacheRequestError(f"no compiled model {model!r} in the cache {d} ('amble cache list' shows them)")
-    out = Removal(d, dry_run)
+    models, runtimes = _chosen(c, everything, cutoff, model)
+    run = _Clearing(Removal(d, dry_run), start, min((_began(e) for e in marks), default=math.inf) - _SLACK)
+    for e in models:
+        named = admin.recorded_files(e)
+        run.take(e, lambda p, st, named=named: run.in_use(p, st) or (
+            "a build in progress renamed it into place and has not recorded it yet"
+            if p not in named and start - st.st_mtime <= cache.ORPHAN_AGE else None))
+    # a model build that began meanwhile would link one
+    linking = bool(marks) or bool(runtimes and admin.building(admin.scan(d)))
+    for e in runtimes:
+        run.take(e, lambda p, st: "a build in progress may be linking it" if linking else run.in_use(p, st))
+    remaining = {e.key for e in _still(c.models, run.out)}
+    gone_keys = {e.key for e in run.out.removed if e.kind == "model" and any(p.suffix == ".json" for p in e.files)}
+    for e in c.index:
+        hit = admin.index_library(e)
+        keys = set(admin.index_keys(hit[1])) if hit else set()
+        stale = not keys & remaining and (bool(keys & gone_keys) or e.last_used < cutoff)
+        if everything or stale:
+            run.take(e, run.in_use)
+    for e in c.stamps if everything else []:
+        run.take(e, run.in_use)
+    for e in c.temporaries:
+        fresh = e in marks
+        if fresh and everything:
+            run.out.kept.append((e.files[0], "a build in progress"))
+        elif not fresh:  # a killed build's, unless written again since the scan
+            run.take(e, lambda p, st: "a build in progress" if start - st.st_mtime <= cache.ORPHAN_AGE else None)
+    return run.out
 
-    def take(e: Entry, why_kept: Any) -> None:
+
+def _chosen(c: admin.Contents, everything: bool, cutoff: float, model: str | None) -> tuple[list[Entry], list[Entry]]:
+    """The libraries and runtime objects a clear is asked to remove."""
+    if everything:
+        return c.models, c.runtimes
+    if model is None:  # older than the cutoff
+        return [e for e in c.models if e.last_used < cutoff], [e for e in c.runtimes if e.last_used < cutoff]
+    models = [e for e in c.models if model in (e.name, *e.specs)]
+    if not models:
+        raise CacheRequestError(f"no compiled model {model!r} in the cache {c.directory} "
+                                "('amble cache list' shows them)")
+    return models, []
+
+
+@dataclass
+class _Clearing:
+    """One clear in progress: what it removed and kept so far, when it began (``start``) and when
+    the oldest build in progress began (``began``)."""
+
+    out: Removal
+    start: float
+    began: float
+
+    def in_use(self, p: Path, st: os.stat_result) -> str | None:
+        if st.st_mtime >= self.began or st.st_mtime > self.start:
+            return "a build in progress may be writing or loading it"
+        return None
+
+    def take(self, e: Entry, why_kept: Callable[[Path, os.stat_result], str | None]) -> None:
+        """Remove the files of ``e`` that ``why_kept`` has no reason to keep (the record first)."""
         gone = []
         for p in sorted(e.files, key=lambda p: p.suffix != ".json"):  # the record first
             st = admin.lstat(p)
@@ -109,47 +156,15 @@ def clear(d: Path | None = None, *, everything: bool = False, older_than: float 
                 continue  # removed meanwhile
             size = e.bytes if p.is_dir() else st.st_size  # a build directory: the files in it
             why = why_kept(p, st)
-            if why is None and not dry_run:
+            if why is None and not self.out.dry_run:
                 why = _remove(p)
             if why is None:
                 gone.append((p, size))
             elif why:  # "": removed by another process meanwhile, neither ours nor kept
-                out.kept.append((p, why))
+                self.out.kept.append((p, why))
         if gone:
-            out.removed.append(Entry(e.kind, e.key, tuple(p for p, _ in gone), sum(n for _, n in gone),
-                                     e.last_used, e.name, e.derivatives, e.specs, e.capacity, e.recorded))
-
-    def in_use(p: Path, st: os.stat_result) -> str | None:
-        if st.st_mtime >= began or st.st_mtime > start:
-            return "a build in progress may be writing or loading it"
-        return None
-
-    for e in models:
-        named = admin.recorded_files(e)
-        take(e, lambda p, st, named=named: in_use(p, st) or (
-            "a build in progress renamed it into place and has not recorded it yet"
-            if p not in named and start - st.st_mtime <= cache.ORPHAN_AGE else None))
-    # a model build that began meanwhile would link one
-    linking = bool(marks) or bool(runtimes and admin.building(admin.scan(d)))
-    for e in runtimes:
-        take(e, lambda p, st: "a build in progress may be linking it" if linking else in_use(p, st))
-    remaining = {e.key for e in _still(c.models, out)}
-    gone_keys = {e.key for e in out.removed if e.kind == "model" and any(p.suffix == ".json" for p in e.files)}
-    for e in c.index:
-        hit = admin.index_library(e)
-        keys = set(admin.index_keys(hit[1])) if hit else set()
-        stale = not keys & remaining and (bool(keys & gone_keys) or e.last_used < cutoff)
-        if everything or stale:
-            take(e, in_use)
-    for e in c.stamps if everything else []:
-        take(e, in_use)
-    for e in c.temporaries:
-        fresh = e in marks
-        if fresh and everything:
-            out.kept.append((e.files[0], "a build in progress"))
-        elif not fresh:  # a killed build's, unless written again since the scan
-            take(e, lambda p, st: "a build in progress" if start - st.st_mtime <= cache.ORPHAN_AGE else None)
-    return out
+            self.out.removed.append(Entry(e.kind, e.key, tuple(p for p, _ in gone), sum(n for _, n in gone),
+                                          e.last_used, e.name, e.derivatives, e.specs, e.capacity, e.recorded))
 
 
 def _still(models: list[Entry], out: Removal) -> list[Entry]:
