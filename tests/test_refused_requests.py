@@ -25,6 +25,24 @@ def test_a_refused_sweep_file_stays_byte_identical(tmp_path, monkeypatch, conten
                  "synchronous"])
     assert code == 2
     assert (tmp_path / "f.csv").read_bytes() == content
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.csv"]  # not even a lock file is left
+
+
+def test_a_sweep_leaves_its_results_and_no_lock_file(tmp_path):
+    """The lock of a result file is removed by its holder; while it is held a second sweep is
+    refused, and once released (and its file gone) a third takes it again."""
+    from amble.analysis.store import ResultStore
+    from amble.errors import OutputError
+
+    out = tmp_path / "r.csv"
+    with ResultStore(out, ["slope", "period"], ["slope"]):
+        assert (tmp_path / ".r.csv.lock").read_text() == str(os.getpid())
+        with pytest.raises(OutputError, match="in use by another sweep"):
+            ResultStore(out, ["slope", "period"], ["slope"])
+    assert not (tmp_path / ".r.csv.lock").exists()
+    with ResultStore(out, ["slope", "period"], ["slope"]):
+        assert (tmp_path / ".r.csv.lock").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
 
 
 def test_more_workers_than_cores_are_capped_with_a_warning():

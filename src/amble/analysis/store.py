@@ -64,7 +64,7 @@ class ResultStore:
     read (not UTF-8 text, not Parquet) is an :class:`OutputError` too; it is never overwritten.
 
     A store with a file holds an exclusive advisory lock on ``.FILE.lock`` from construction to
-    :meth:`close` (it is a context manager): a second sweep on the same file is refused with an
+    :meth:`close` (it is a context manager; the lock file is removed then): a second sweep on the same file is refused with an
     :class:`OutputError` instead of both writing it (the compaction of one would drop the rows
     of the other).
     """
@@ -96,7 +96,7 @@ class ResultStore:
     def close(self) -> None:
         """Release the file's lock (rows already appended are durable)."""
         if self._lock is not None:
-            self._lock.close()  # closing the descriptor releases the flock
+            _unlock(self._lock)
             self._lock = None
 
     def __enter__(self) -> ResultStore:
@@ -314,29 +314,51 @@ def _is_type(text: str, kind: str) -> bool:
 
 def _lock(final: Path) -> Any:
     """An open lock file beside ``final``, exclusively locked; :class:`OutputError` if another
-    process holds it. Where ``fcntl`` is missing (Windows) sweeps are not locked."""
+    process holds it. Where ``fcntl`` is missing (Windows) sweeps are not locked.
+
+    The holder removes the lock file when it closes (:func:`_unlock`), so no request — a refused
+    one included — leaves a file behind. A lock taken on a file that was removed meanwhile is no
+    lock (a third process may create the name anew): the path must still name the locked file,
+    else the lock is taken again."""
     try:
         import fcntl
     except ImportError:
         return None
     path = final.with_name(f".{final.name}.lock")
-    try:
-        f = open(path, "a+")
-    except OSError as e:
-        raise OutputError(f"cannot lock result file {str(final)!r} ({e.strerror or e})") from None
-    try:
-        fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        f.seek(0)
-        holder = f.read().strip()
+    while True:
+        try:
+            f = open(path, "a+")
+        except OSError as e:
+            raise OutputError(f"cannot lock result file {str(final)!r} ({e.strerror or e})") from None
+        try:
+            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            f.seek(0)
+            holder = f.read().strip()
+            f.close()
+            raise OutputError(f"result file {str(final)!r} is in use by another sweep"
+                              f"{f' (process {holder})' if holder else ''}; wait for it or use another file") from None
+        try:
+            same = os.stat(path).st_ino == os.fstat(f.fileno()).st_ino
+        except OSError:  # removed by its holder between our open and our lock
+            same = False
+        if same:
+            break
         f.close()
-        raise OutputError(f"result file {str(final)!r} is in use by another sweep"
-                          f"{f' (process {holder})' if holder else ''}; wait for it or use another file") from None
     f.seek(0)
     f.truncate()
     f.write(str(os.getpid()))
     f.flush()
     return f
+
+
+def _unlock(f: Any) -> None:
+    """Remove the lock file (still holding the lock, so no one else can be using it) and release it."""
+    try:
+        os.unlink(f.name)
+    except OSError:
+        pass
+    f.close()
 
 
 class _SortField(dict):
