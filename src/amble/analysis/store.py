@@ -64,9 +64,9 @@ class ResultStore:
     read (not UTF-8 text, not Parquet) is an :class:`OutputError` too; it is never overwritten.
 
     A store with a file holds an exclusive advisory lock on ``.FILE.lock`` from construction to
-    :meth:`close` (it is a context manager; the lock file is removed then): a second sweep on the same file is refused with an
-    :class:`OutputError` instead of both writing it (the compaction of one would drop the rows
-    of the other).
+    :meth:`close` (it is a context manager; the lock file is removed then): a second sweep on the
+    same file is refused with an :class:`OutputError` instead of both writing it (the compaction
+    of one would drop the rows of the other).
     """
 
     def __init__(self, path: str | os.PathLike | None, columns: Sequence[str] | Mapping[str, str],
