@@ -16,6 +16,7 @@ import amble
 from amble import Model, ModelError
 from amble.cli.main import main
 from amble.modelling.tree import Joint
+from amble.models import load_file
 
 ROOT = Path(__file__).resolve().parent.parent
 WALKER = ROOT / "examples" / "my_walker.py"
@@ -119,6 +120,8 @@ def test_a_model_file_that_exits_is_a_model_error(capsys, tmp_path, source, code
     assert status == 2
     assert json.loads(out)["type"] == "ModelError"
     assert err.count("\n") == 1 and f"sys.exit({code})" in err and "quits.py" in err, err
+    with pytest.raises(ModelError, match=rf"sys.exit\({code}\)"):  # the API says so too
+        load_file(str(f))
 
 
 @pytest.mark.parametrize("path", ["a" * 5000 + ".py", "d/" * 3000 + "m.py:build"], ids=["long-name", "deep-path"])

@@ -129,11 +129,7 @@ def load_model(name: str, *, compiled: bool = False, derivatives: bool = False):
 
     if is_file_spec(name):
         _check_model_path(name)
-    try:
-        return _load(name, compiled, derivatives)
-    except SystemExit as e:  # not an Exception: it would pass every handler up to the interpreter
-        raise ModelError(f"model file {_shown(name)} called sys.exit({e.code!r}) while it was loaded; "
-                         "a model file builds a system and returns it") from None
+    return _load(name, compiled, derivatives)  # a file's sys.exit() is load_file's ModelError
 
 
 def _load(name: str, compiled: bool, derivatives: bool):

@@ -201,6 +201,9 @@ def load_file(spec: str) -> HybridSystem:
         raise ModelError(_where(e, path) + str(e).splitlines()[0]) from e
     except SyntaxError as e:
         raise ModelError(f"{path_text}:{e.lineno}: SyntaxError: {e.msg}") from None
+    except SystemExit as e:  # not an Exception: it would pass every handler up to the interpreter
+        raise ModelError(f"model file {path_text!r} called sys.exit({e.code!r}) while it was loaded; "
+                         "a model file builds a system and returns it") from None
     except Exception as e:  # anything the user's code raises: one line, with its place in the file
         first = str(e).splitlines()[0] if str(e) else ""
         raise ModelError(f"{_where(e, path)}{type(e).__name__}: {first}") from e
