@@ -50,6 +50,12 @@ def _energy(tr, k1: float, k2: float, d: float, g: float = 9.81) -> np.ndarray:
 _E_TOL = 1e-6
 
 
+def _grazing(k1: float, k2: float, d: float, g: float = 9.81) -> bool:
+    """Whether the net force at the switch θ = d vanishes on one side (−g sin d − k₁ above,
+    −g sin d + k₂ below): the flow there is tangent to the switch (the expected failure below)."""
+    return min(abs(-g * np.sin(d) - k1), abs(-g * np.sin(d) + k2)) < 1e-6
+
+
 def _check_energy(tr, k1: float, k2: float, c: float, d: float, f: float) -> None:
     if c != 0.0:
         return  # the switch θ + cθ̇ = d makes the torque depend on θ̇: it has no potential
@@ -68,7 +74,7 @@ def _check_energy(tr, k1: float, k2: float, c: float, d: float, f: float) -> Non
     th0=st.floats(-1.0, 1.0), thd0=st.floats(-3.0, 3.0),
 )
 def test_random_switching_forces_and_guards_end_within_the_budget(k1, k2, c, d, f, a, th0, thd0):
-    assume(not (c == 0.0 and d == 0.0 and min(k1, k2) < 1e-9))  # the expected failure below
+    assume(c != 0.0 or not _grazing(k1, k2, d))  # the expected failure below
     params = {"k1": k1, "k2": k2, "c": c, "d": d, "f": f, "A": a}
     tr = amble.simulate(_system(), [th0, thd0], params=params, t_end=5.0, options=_BUDGET)
     # c < 0 tilts the switching line so that the flow leaves it on both sides near θ̇ = 0: a
@@ -91,13 +97,18 @@ def test_random_switching_forces_and_guards_end_within_the_budget(k1, k2, c, d, 
 def test_random_conservative_switching_forces_conserve_energy(k1, k2, d, a, th0, thd0):
     # τ = −k₁ above θ = d, +k₂ below, no friction: a force with a potential, so
     # ½θ̇² + g(1 − cos θ) + U(θ) is constant through every crossing of the switch.
-    # A force that vanishes at the switch on one side (d = 0 with k₁ or k₂ = 0, or as small as
-    # 1e-38) is the case of the expected failure below, kept out of the random draws so that
-    # they test the rest
-    assume(not (d == 0.0 and min(k1, k2) < 1e-9))
+    # A force that vanishes at the switch on one side is the case of the expected failure
+    # below, kept out of the random draws so that they test the rest
+    assume(not _grazing(k1, k2, d))
     params = {"k1": k1, "k2": k2, "c": 0.0, "d": d, "f": 0.0, "A": a}
     tr = amble.simulate(_system(), [th0, thd0], params=params, t_end=5.0, options=_BUDGET)
-    assert tr.status in ("end_time", "past_A", "zeno", "sliding"), tr.message
+    # a start just below a switch that pushes back from both sides (k₁, k₂ > 0) oscillates about
+    # it with an amplitude of |θ₀ − d|, crossing it every few ms: a tiny enough one outlasts the
+    # step budget, and must say that it chatters about the switch
+    if tr.status == "stalled":
+        assert "chatters about the switch" in tr.message and abs(tr.final_state[0] - d) < 1e-3, tr.message
+    else:
+        assert tr.status in ("end_time", "past_A", "zeno", "sliding"), tr.message
     _check_energy(tr, k1, k2, 0.0, d, 0.0)
 
 
