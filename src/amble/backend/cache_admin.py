@@ -109,13 +109,12 @@ def iso_time(t: float) -> str:
 
 
 def directory() -> Path:
-    """The cache directory amble compiles into; :class:`CacheRequestError` if the configured one
-    cannot be used (amble then compiles into a temporary directory per process, with a warning,
-    and there is no cache to see or clear)."""
+    """The configured cache directory; :class:`CacheRequestError` if it cannot be used (amble then
+    compiles into its fallback with a warning, :mod:`amble.backend.cache_home`, and the configured
+    directory is neither listed nor cleared)."""
     d, why = cache.configured()
     if why is not None:
-        raise CacheRequestError(f"the cache {d} is not usable ({why}): amble compiles into a temporary "
-                                "directory per process instead")
+        raise CacheRequestError(f"the cache {d} is not usable ({why}); nothing in it is listed or removed")
     return d
 
 
