@@ -21,6 +21,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import ModelError
+from ..modelling.text import expr_of
 
 
 def casadi_module() -> Any:
@@ -302,7 +303,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     guard = ca.Function("guard", [q, qd, p], [T(tr.guard.expr)], ["q", "qd", "p"], ["g"])
     conds = _conditions(tr.guard.enabled)
     enabled = ca.Function("enabled", [q, qd, p], [ca.vertcat(*[T(c) for c in conds]) if conds else ca.SX(0, 1)])
-    slope = sp.sympify(getattr(system, "slope", 0))
+    slope = expr_of(getattr(system, "slope", 0), what="slope")  # text is refused, never evaluated
     nvec = [sp.sin(slope), sp.cos(slope)] if d == 2 else [sp.sin(slope), 0, sp.cos(slope)]
     dvec = [sp.cos(slope), -sp.sin(slope)] if d == 2 else [sp.cos(slope), 0, -sp.sin(slope)]
     foot = m.points[tr.reset.impact_point]
@@ -338,7 +339,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
 
 def _output_texts(vc: Any, B: sp.Matrix, q: list) -> list[str]:
     """The outputs as text: the model's declared ones, else ``B_jᵀ q`` with numeric coefficients
-    written as floats (``-1.0*stance + 1.0*swing``: parsed back by ``sympify``)."""
+    written as floats (``-1.0*stance + 1.0*swing``: read back by :func:`amble.parse`)."""
     if vc is not None:
         return [sp.sstr(e) for e in vc.outputs]
     coef = lambda b: sp.Float(b, 12) if b.is_number else b
