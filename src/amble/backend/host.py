@@ -17,9 +17,12 @@ valgrind, which does not decode every AVX-512 instruction). A compiler that refu
 ``-march=native`` compiles without it. Flags that let the compiler assume no NaN or infinity
 occurs (``-ffast-math``, ``-Ofast``, ``-ffinite-math-only``, clang's ``-fno-honor-nans`` and
 ``-fno-honor-infinities``) would compile away the checks that end a run whose state is no longer
-finite (status ``integrator_failure``) and make it run on with NaNs: they are neutralised —
-``-fno-finite-math-only`` (and ``-fhonor-…``) appended, so the rest of what was asked for still
-applies — with one :class:`FlagsWarning` per process.
+finite (status ``integrator_failure``) and make it run on with NaNs; and ``-ffast-math``,
+``-Ofast`` and ``-funsafe-math-optimizations`` on the link line make GCC (before 13) link
+``crtfastmath.o`` into the library, which sets flush-to-zero for the *whole process* when the
+library loads (every subnormal number in NumPy, SciPy and Python becomes 0). They are replaced by
+their harmless parts (:data:`_REPLACED`: reassociation, reciprocals, no signed zeros, no
+``errno``), with one :class:`FlagsWarning` per process.
 """
 
 from __future__ import annotations
@@ -36,10 +39,13 @@ _CPU_FIELDS = ("vendor_id", "cpu family", "model", "model name", "flags", "featu
                "cpu architecture", "cpu variant", "cpu part")
 
 
-#: Flags that let the compiler assume every value finite, and the flags that undo that (appended).
-_FINITE_ONLY = {"-ffast-math": "-fno-finite-math-only", "-Ofast": "-fno-finite-math-only",
-                "-ffinite-math-only": "-fno-finite-math-only",
-                "-fno-honor-nans": "-fhonor-nans", "-fno-honor-infinities": "-fhonor-infinities"}
+#: The parts of the unsafe math flags that keep NaN and infinity and set no processor mode.
+_HARMLESS = ("-fno-math-errno", "-fno-signed-zeros", "-fno-trapping-math", "-fassociative-math", "-freciprocal-math")
+#: Flags amble does not compile with → what it compiles with instead (see the module docstring).
+_REPLACED: dict[str, tuple[str, ...]] = {
+    "-ffast-math": _HARMLESS, "-Ofast": ("-O3", *_HARMLESS), "-funsafe-math-optimizations": _HARMLESS[1:],
+    "-ffinite-math-only": (), "-fno-honor-nans": (), "-fno-honor-infinities": (),
+}
 
 
 class FlagsWarning(UserWarning):
@@ -47,11 +53,13 @@ class FlagsWarning(UserWarning):
 
 
 def ieee(flags: list[str]) -> tuple[list[str], list[str]]:
-    """``flags`` with every assumption of finite values undone (see the module docstring), and
-    the flags that asked for it (empty: unchanged)."""
-    asked = [f for f in flags if f in _FINITE_ONLY]
-    undo = list(dict.fromkeys(_FINITE_ONLY[f] for f in asked))
-    return ([*flags, *undo] if asked else flags), asked
+    """``flags`` with every flag that assumes finite values or sets flush-to-zero replaced by its
+    harmless parts (see the module docstring), and the flags replaced (empty: unchanged)."""
+    asked = [f for f in flags if f in _REPLACED]
+    if not asked:
+        return flags, []
+    out = [g for f in flags for g in (_REPLACED.get(f, (f,)))]
+    return list(dict.fromkeys(out)), asked
 
 
 def flags_setting() -> str:
@@ -68,7 +76,12 @@ def setting_of(flags: str | None) -> str:
 @lru_cache(maxsize=8)
 def _setting(flags: str) -> str:
     # one string object per setting: the keys' caches hash it once, not a kilobyte per build()
-    flags = " ".join(ieee(flags.split())[0])  # the flags compiled with, not the ones asked for
+    used, asked = ieee(flags.split())  # the flags compiled with, not the ones asked for
+    if asked:  # said once per setting, whether the library is compiled now or was before
+        warnings.warn(f"amble: AMBLE_CFLAGS {' '.join(asked)} would compile away the checks of a state that is no "
+                      f"longer finite (or flush subnormal numbers to zero in the whole process); compiling with "
+                      f"{' '.join(used)}", FlagsWarning, stacklevel=5)
+    flags = " ".join(used)
     return f"{flags}\0{cpu_identity()}" if "native" in flags else flags
 
 
@@ -76,21 +89,11 @@ def cflags(cc: str) -> list[str]:
     """The flags to compile with, for compiler command ``cc``: the setting with IEEE semantics
     restored (see the module docstring), without its ``native`` options if ``cc`` does not
     accept them."""
-    given = os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS).split()
-    flags, asked = ieee(given)
-    if asked:
-        _warn_once(" ".join(asked), " ".join(flags[len(given):]))
+    flags = ieee(os.environ.get("AMBLE_CFLAGS", DEFAULT_CFLAGS).split())[0]
     native = [f for f in flags if f.endswith("=native")]
     if native and not _accepts(cc, tuple(native)):
         flags = [f for f in flags if f not in native]
     return flags
-
-
-@lru_cache(maxsize=8)
-def _warn_once(asked: str, added: str) -> None:
-    warnings.warn(f"amble: AMBLE_CFLAGS {asked} would let the compiler assume no NaN or infinity and compile "
-                  f"away the checks of a state that is no longer finite; compiling with {added} appended",
-                  FlagsWarning, stacklevel=4)
 
 
 @lru_cache(maxsize=1)
