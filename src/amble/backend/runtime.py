@@ -15,7 +15,7 @@ variable-length array of the model's own length.
 
 An object is cached under ``runtime-<key>-<sha>.o`` with ``runtime-<key>.json`` recording its
 SHA-256; the key is a hash of every engine source (``backend/_c``), the interface header
-(:func:`amble.backend.abi.c_header`), the compiler, its version and the flags, and the
+(:func:`amble.backend.abi.c_header`) and the table of integrators (:func:`~amble.backend.abi.c_steppers`), the compiler, its version and the flags, and the
 capacity. An object whose bytes do not match is rebuilt; every file is written under a temporary
 name and renamed, so processes building at once each end with a valid object. A model library's
 own key (:func:`amble.backend.cache.structure_key`) covers all of these inputs, since the capacity
@@ -94,6 +94,7 @@ def _sources_digest() -> str:
         if f.suffix in (".c", ".h"):
             h.update(f.name.encode() + b"\0" + f.read_bytes())
     h.update(abi.c_header().encode())
+    h.update(abi.c_steppers().encode())
     return h.hexdigest()
 
 
@@ -123,6 +124,7 @@ def build(d: Path, cap: int, tc: Toolchain) -> Path:
     key, cc = runtime_key(cap, tc), tc.cc
     with tempfile.TemporaryDirectory(prefix="build-", dir=d) as tmpd:
         (Path(tmpd) / "amble_abi.h").write_text(abi.c_header())
+        (Path(tmpd) / "amble_steppers.h").write_text(abi.c_steppers())
         out = Path(tmpd) / "runtime.o"
         cmd = [*cc.split(), *tc.flags, "-std=c99", "-Werror=implicit-function-declaration", "-fPIC",
                f"-D{CAPACITY_MACRO}={cap}", "-I", tmpd, "-I", str(C_DIR), "-c", str(C_DIR / "runtime.c"),

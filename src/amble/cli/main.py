@@ -19,7 +19,7 @@ from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
-from ..simulation.engine import METHODS, Options
+from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
@@ -92,7 +92,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
     drawn = bool(plot_p or anim_p)
-    s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or args.method == "radau")
+    s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or NEEDS_JACOBIAN[args.method])
     if out_p and any(m.inputs for m in s.modes.values()):
         s = s.full()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)

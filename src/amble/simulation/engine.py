@@ -16,7 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
+from ..backend.abi import (CODE, CTX, CTX_X, HAS_SENSITIVITIES, IOPT, IOPT_FIELDS, METHOD, NEEDS_JACOBIAN, OPT,
+                           OPT_FIELDS, OUTCOME, sens_layout)
+from ..backend.abi import METHODS as _METHOD_ROWS
 from ..backend.kernels import Kernels
 from ..errors import StateError
 
@@ -25,8 +27,10 @@ from ..errors import StateError
 #: this bounds the growth of the process's peak memory by the recording too.
 RECORD_BUDGET = 512 * 2**20
 
-#: Integrators, in the order of the compiled loop's IO_METHOD codes.
-METHODS = ("dop853", "radau")
+#: Integrators, by name, in the order of their codes (the table of :mod:`amble.backend.abi`).
+METHODS = tuple(name for _, name, _, _ in _METHOD_ROWS)
+#: The integrators that give sensitivities (their stages carry the variational equations).
+SENSITIVITY_METHODS = tuple(m for m in METHODS if HAS_SENSITIVITIES[m])
 
 #: Accepted integrator steps per compiled call: the loop returns this often so that Python can
 #: handle signals (Ctrl-C), then resumes exactly where it stopped.
@@ -98,7 +102,7 @@ class Options:
         values = {"MAXSTEPS": 0, "MAXEVENTS": self.max_events, "OUTCAP": 0, "EVCAP": 0, "ZENON": self.zeno_events,
                   "NSUB": self.nsub, "MAXISTEPS": self.max_integrator_steps,
                   "MAXISTEPS_EV": self.max_steps_between_events, "YIELDN": YIELD_STEPS,
-                  "METHOD": METHODS.index(self.method)}
+                  "METHOD": METHOD[self.method]}
         return np.array([values[f] for f in IOPT_FIELDS], dtype=np.int64)
 
 
@@ -189,12 +193,13 @@ def run(
     buf = _Buffers.take(0 if events_only else _first_rows(nxm, budget), nxm) if record else _NO_RECORDING
     if sensitivities not in (False, True, "state"):
         raise StateError(f"sensitivities must be True, False or 'state', got {sensitivities!r}")
-    if (sensitivities or opts.method != "dop853") and not k.meta.get("derivatives"):
+    if (sensitivities or NEEDS_JACOBIAN[opts.method]) and not k.meta.get("derivatives"):
         raise StateError(f"system {k.meta['name']!r}: sensitivities and the implicit integrator need the kernels "
                          "built with their derivatives: build(system, derivatives=True)")
-    if sensitivities and opts.method != "dop853":
-        # the variational equations ride on the explicit method's stages
-        raise StateError(f"sensitivities need method='dop853', not {opts.method!r}")
+    if sensitivities and not HAS_SENSITIVITIES[opts.method]:
+        # the variational equations ride on an explicit method's stages
+        raise StateError(f"sensitivities need method={' or '.join(map(repr, SENSITIVITY_METHODS))}, "
+                         f"not {opts.method!r}")
     sens = _sensitivity_buffer(k, x0.size, sensitivities is True) if sensitivities else None
     sens_addr = sens.ctypes.data if sens is not None else None
     code = _YIELD
