@@ -71,6 +71,7 @@ IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZEN
 METHODS: tuple[tuple[int, str, bool, bool], ...] = (
     (0, "dop853", False, True),   # explicit, 8th order, 7th-order dense output: the default
     (1, "radau", True, False),    # Radau IIA, implicit, 5th order: stiff runs
+    (2, "tsit5", False, True),    # Tsitouras 5(4), explicit, free 4th-order dense output
 )
 
 #: The sensitivity buffer (float64, ``_c/sensitivity.h``) of a run that carries ∂x/∂(x0, p), in

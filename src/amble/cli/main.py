@@ -297,7 +297,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
     s.add_argument("--method", choices=METHODS, default="dop853",
-                   help="integrator: dop853 (explicit, default) or radau (implicit, for stiff models)")
+                   help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
+                        "tsit5 (explicit, 5th order)")
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)

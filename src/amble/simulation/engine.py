@@ -50,7 +50,7 @@ _IO_MAXSTEPS, _IO_OUTCAP, _IO_EVCAP = IOPT["MAXSTEPS"], IOPT["OUTCAP"], IOPT["EV
 class Options:
     """Integration and outcome settings.
 
-    rtol, atol: DOP853 tolerances (relative, absolute). max_step: largest step (s, 0 = none).
+    rtol, atol: the integrator's tolerances (relative, absolute). max_step: largest step (s, 0 = none).
     max_step_time: a walker that makes no footfall for this long has ``fell`` (s, 0 = never).
     zeno_dt, zeno_events: this many consecutive events each closer than ``zeno_dt`` (s) to the
     previous one end the run as ``zeno``. max_events: hard cap on events. nsub: uniform guard
@@ -59,9 +59,11 @@ class Options:
     max_integrator_steps: cap on accepted integrator steps of a run (status
     ``max_integrator_steps``); max_steps_between_events: cap on accepted steps between two
     transitions (status ``stalled``: a stiff or chattering run). 0: no cap. method: ``"dop853"``
-    (explicit, 8th order: the default) or ``"radau"`` (Radau IIA, implicit, 5th order, with the
+    (explicit, 8th order: the default), ``"radau"`` (Radau IIA, implicit, 5th order, with the
     model's exact Jacobian in its Newton iterations: for stiff runs — high-gain controllers, stiff
-    springs — where an explicit method's step is bounded by stability rather than accuracy).
+    springs — where an explicit method's step is bounded by stability rather than accuracy) or
+    ``"tsit5"`` (Tsitouras 5(4), explicit, with a free 4th-order dense output: cheaper steps at
+    moderate tolerances).
     """
 
     rtol: float = 1e-10

@@ -154,8 +154,9 @@ def simulate(
         the trajectory then holds without a copy (so the process's peak memory grows by about
         this much at most); a run that would record more ends as ``record_limit`` with what it has.
     method:
-        ``"dop853"`` (explicit, the default) or ``"radau"`` (implicit Radau IIA with the model's
-        exact Jacobian, for stiff systems); default that of ``options``.
+        ``"dop853"`` (explicit, the default), ``"radau"`` (implicit Radau IIA with the model's
+        exact Jacobian, for stiff systems) or ``"tsit5"`` (explicit Tsitouras 5(4)); default that
+        of ``options``.
     """
     base = options or _DEFAULT_OPTIONS
     if not isinstance(base, Options):
