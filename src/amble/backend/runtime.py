@@ -8,7 +8,7 @@ linked. It is compiled once per *capacity* into an object in the cache directory
 compiles only its generated kernels (and the DOP853 step, with its right-hand side inlined) and
 links them with that object.
 
-The capacity is the state length the integrator's arrays hold (``Dop`` in ``_c/dop853.h``): the
+The capacity is the state length the integrator's arrays hold (``Step`` in ``_c/stepper.h``): the
 model's longest state rounded up to a power of two, at least 8 (:func:`capacity`), so a handful of
 runtime objects serve every model. Everything else the runtime sizes by the model is a C99
 variable-length array of the model's own length.

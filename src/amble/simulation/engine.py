@@ -62,8 +62,8 @@ class Options:
     (explicit, 8th order: the default), ``"radau"`` (Radau IIA, implicit, 5th order, with the
     model's exact Jacobian in its Newton iterations: for stiff runs — high-gain controllers, stiff
     springs — where an explicit method's step is bounded by stability rather than accuracy) or
-    ``"tsit5"`` (Tsitouras 5(4), explicit, with a free 4th-order dense output: cheaper steps at
-    moderate tolerances).
+    ``"tsit5"`` (Tsitouras 5(4), explicit, with a free 4th-order dense output and SciPy's RK45
+    step control: comparable with other 5th-order codes).
     """
 
     rtol: float = 1e-10
