@@ -137,7 +137,8 @@ LAYOUT = int(sha256(_layout_text().encode()).hexdigest()[:15], 16)
 
 def c_header(layout: int | None = None) -> str:
     """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*``, ``MT_*`` (method
-    codes) and ``N_METHODS``, ``SENS_*`` (offsets in terms of the unit's ``NXMAX`` and ``SC``) and ``AMBLE_LAYOUT`` (default
+    codes) and ``N_METHODS``, ``SENS_*`` (offsets in terms of the unit's ``NXMAX`` and ``SC``) and
+    ``AMBLE_LAYOUT`` (default
     :data:`LAYOUT`), written into every generated translation unit before the engine is included.
     Integer arrays shared with NumPy int64 are ``int64_t``."""
     lines = ["/* Python <-> C interface, generated from amble/backend/abi.py; do not edit. */",

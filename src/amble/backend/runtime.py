@@ -15,7 +15,8 @@ variable-length array of the model's own length.
 
 An object is cached under ``runtime-<key>-<sha>.o`` with ``runtime-<key>.json`` recording its
 SHA-256; the key is a hash of every engine source (``backend/_c``), the interface header
-(:func:`amble.backend.abi.c_header`) and the table of integrators (:func:`~amble.backend.abi.c_steppers`), the compiler, its version and the flags, and the
+(:func:`amble.backend.abi.c_header`) and the table of integrators
+(:func:`~amble.backend.abi.c_steppers`), the compiler, its version and the flags, and the
 capacity. An object whose bytes do not match is rebuilt; every file is written under a temporary
 name and renamed, so processes building at once each end with a valid object. A model library's
 own key (:func:`amble.backend.cache.structure_key`) covers all of these inputs, since the capacity

@@ -92,7 +92,8 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
     drawn = bool(plot_p or anim_p)
-    s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or NEEDS_JACOBIAN[args.method])
+    derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
+    s = load_model(args.model, compiled=not drawn, derivatives=derivatives)
     if out_p and any(m.inputs for m in s.modes.values()):
         s = s.full()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)

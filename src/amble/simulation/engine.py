@@ -16,9 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.abi import (CODE, CTX, CTX_X, HAS_SENSITIVITIES, IOPT, IOPT_FIELDS, METHOD, NEEDS_JACOBIAN, OPT,
-                           OPT_FIELDS, OUTCOME, sens_layout)
-from ..backend.abi import METHODS as _METHOD_ROWS
+from ..backend import abi
+from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
 from ..backend.kernels import Kernels
 from ..errors import StateError
 
@@ -28,9 +27,11 @@ from ..errors import StateError
 RECORD_BUDGET = 512 * 2**20
 
 #: Integrators, by name, in the order of their codes (the table of :mod:`amble.backend.abi`).
-METHODS = tuple(name for _, name, _, _ in _METHOD_ROWS)
+METHODS = tuple(name for _, name, _, _ in abi.METHODS)
+#: Per integrator: do the kernels need their derivatives (an implicit method's Newton matrix)?
+NEEDS_JACOBIAN = abi.NEEDS_JACOBIAN
 #: The integrators that give sensitivities (their stages carry the variational equations).
-SENSITIVITY_METHODS = tuple(m for m in METHODS if HAS_SENSITIVITIES[m])
+SENSITIVITY_METHODS = tuple(m for m in METHODS if abi.HAS_SENSITIVITIES[m])
 
 #: Accepted integrator steps per compiled call: the loop returns this often so that Python can
 #: handle signals (Ctrl-C), then resumes exactly where it stopped.
@@ -104,7 +105,7 @@ class Options:
         values = {"MAXSTEPS": 0, "MAXEVENTS": self.max_events, "OUTCAP": 0, "EVCAP": 0, "ZENON": self.zeno_events,
                   "NSUB": self.nsub, "MAXISTEPS": self.max_integrator_steps,
                   "MAXISTEPS_EV": self.max_steps_between_events, "YIELDN": YIELD_STEPS,
-                  "METHOD": METHOD[self.method]}
+                  "METHOD": abi.METHOD[self.method]}
         return np.array([values[f] for f in IOPT_FIELDS], dtype=np.int64)
 
 
@@ -198,7 +199,7 @@ def run(
     if (sensitivities or NEEDS_JACOBIAN[opts.method]) and not k.meta.get("derivatives"):
         raise StateError(f"system {k.meta['name']!r}: sensitivities and the implicit integrator need the kernels "
                          "built with their derivatives: build(system, derivatives=True)")
-    if sensitivities and not HAS_SENSITIVITIES[opts.method]:
+    if sensitivities and not abi.HAS_SENSITIVITIES[opts.method]:
         # the variational equations ride on an explicit method's stages
         raise StateError(f"sensitivities need method={' or '.join(map(repr, SENSITIVITY_METHODS))}, "
                          f"not {opts.method!r}")
