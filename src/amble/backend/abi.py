@@ -2,7 +2,7 @@
 
 Everything both languages must agree on is listed here once: the run status codes, the fields of
 the resumable context array ``ctx``, of the real and integer option arrays ``opt`` and ``iopt``,
-the layout of the sensitivity buffer, and the integer width of counters. The C header the engine
+the layout of the sensitivity buffer, the integrators, and the integer width of counters. The C header the engine
 includes is generated from these tables (:func:`c_header`), and a loaded library reports its
 layout back, which is compared with :data:`LAYOUT` at load — a stale library is refused instead
 of misread.
@@ -60,7 +60,19 @@ OPT_FIELDS: tuple[str, ...] = ("TEND", "RTOL", "ATOL", "MAXSTEP", "MAXSTEPTIME",
 #: Fields of ``iopt`` (int64), in index order.
 IOPT_FIELDS: tuple[str, ...] = ("MAXSTEPS", "MAXEVENTS", "OUTCAP", "EVCAP", "ZENON", "NSUB",
                                 "MAXISTEPS", "MAXISTEPS_EV", "YIELDN",
-                                "METHOD")  # integrator: 0 DOP853 (explicit), 1 Radau IIA (implicit, stiff)
+                                "METHOD")  # integrator: a code of METHODS
+
+#: Integrators: (code, name, needs_jacobian, has_sensitivities). A row's C side is the stepper
+#: ``<name>_stepper`` (``_c/stepper.h``) of the file ``_c/<name>.h``; the compiled loop reaches a
+#: method only through its row of the table ``STEPPERS`` (:func:`c_steppers`), indexed by code.
+#: needs_jacobian: the kernels must be built with their derivatives (an implicit method's Newton
+#: matrix); has_sensitivities: the method gives its explicit tableau, on whose stages the
+#: variational equations of ``_c/sensitivity.h`` ride.
+METHODS: tuple[tuple[int, str, bool, bool], ...] = (
+    (0, "dop853", False, True),   # explicit, 8th order, 7th-order dense output: the default
+    (1, "radau", True, False),    # Radau IIA, implicit, 5th order: stiff runs
+    (2, "tsit5", False, True),    # Tsitouras 5(4), explicit, free 4th-order dense output
+)
 
 #: The sensitivity buffer (float64, ``_c/sensitivity.h``) of a run that carries ∂x/∂(x0, p), in
 #: order: (name, size as coefficients (a, b, c) of ``a·NXMAX·SC + b·SC + c``). ``NXMAX`` is a
@@ -102,15 +114,20 @@ CTX = {name: i for i, name in enumerate(CTX_FIELDS)}
 OPT = {name: i for i, name in enumerate(OPT_FIELDS)}
 IOPT = {name: i for i, name in enumerate(IOPT_FIELDS)}
 CODE = {name: code for code, name, _ in STATUS}
+METHOD = {name: code for code, name, _, _ in METHODS}
+NEEDS_JACOBIAN = {name: jac for _, name, jac, _ in METHODS}
+HAS_SENSITIVITIES = {name: sens for _, name, _, sens in METHODS}
 OUTCOME = {code: outcome for code, _, outcome in STATUS}
 
 assert len(CTX_FIELDS) <= CTX_X, "ctx fields overlap the state vector"
+assert [m[0] for m in METHODS] == list(range(len(METHODS))), "method codes index the stepper table"
 
 
 def _layout_text() -> str:
     parts = [f"ST_{n}={c}" for c, n, _ in STATUS] + [f"CX_{n}={i}" for n, i in CTX.items()] + [f"CX_X={CTX_X}"]
     parts += [f"OP_{n}={i}" for n, i in OPT.items()] + [f"IO_{n}={i}" for n, i in IOPT.items()]
     parts += [f"SENS_{n}={c}" for n, c in _sens_offsets().items()]
+    parts += [f"MT_{n.upper()}={c}" for c, n, _, _ in METHODS]
     return ";".join(parts)
 
 
@@ -119,8 +136,9 @@ LAYOUT = int(sha256(_layout_text().encode()).hexdigest()[:15], 16)
 
 
 def c_header(layout: int | None = None) -> str:
-    """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*``, ``SENS_*``
-    (offsets in terms of the unit's ``NXMAX`` and ``SC``) and ``AMBLE_LAYOUT`` (default
+    """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*``, ``MT_*`` (method
+    codes) and ``N_METHODS``, ``SENS_*`` (offsets in terms of the unit's ``NXMAX`` and ``SC``) and
+    ``AMBLE_LAYOUT`` (default
     :data:`LAYOUT`), written into every generated translation unit before the engine is included.
     Integer arrays shared with NumPy int64 are ``int64_t``."""
     lines = ["/* Python <-> C interface, generated from amble/backend/abi.py; do not edit. */",
@@ -129,6 +147,19 @@ def c_header(layout: int | None = None) -> str:
     lines += [f"#define CX_{name} {i}" for name, i in CTX.items()] + [f"#define CX_X {CTX_X}"]
     lines += [f"#define OP_{name} {i}" for name, i in OPT.items()]
     lines += [f"#define IO_{name} {i}" for name, i in IOPT.items()] + [f"#define IOPT_LEN {len(IOPT)}"]
+    lines += [f"#define MT_{name.upper()} {code}" for code, name, _, _ in METHODS]
+    lines.append(f"#define N_METHODS {len(METHODS)}")
     lines += [f"#define SENS_{name} {_sens_c(c)}" for name, c in _sens_offsets().items()]
     lines.append(f"#define AMBLE_LAYOUT {LAYOUT if layout is None else layout}LL")
+    return "\n".join(lines) + "\n"
+
+
+def c_steppers() -> str:
+    """The runtime's table of integrators (``amble_steppers.h``): each method's file, then
+    ``STEPPERS``, its stepper at its code. Included by the runtime after ``stepper.h``."""
+    lines = ["/* The integrators, generated from amble/backend/abi.py; do not edit. */"]
+    lines += [f'#include "{name}.h"' for _, name, _, _ in METHODS]
+    lines.append("static const Stepper *const STEPPERS[N_METHODS] = {")
+    lines += [f"    &{name}_stepper, /* MT_{name.upper()} */" for _, name, _, _ in METHODS]
+    lines.append("};")
     return "\n".join(lines) + "\n"

@@ -8,14 +8,15 @@ linked. It is compiled once per *capacity* into an object in the cache directory
 compiles only its generated kernels (and the DOP853 step, with its right-hand side inlined) and
 links them with that object.
 
-The capacity is the state length the integrator's arrays hold (``Dop`` in ``_c/dop853.h``): the
+The capacity is the state length the integrator's arrays hold (``Step`` in ``_c/stepper.h``): the
 model's longest state rounded up to a power of two, at least 8 (:func:`capacity`), so a handful of
 runtime objects serve every model. Everything else the runtime sizes by the model is a C99
 variable-length array of the model's own length.
 
 An object is cached under ``runtime-<key>-<sha>.o`` with ``runtime-<key>.json`` recording its
 SHA-256; the key is a hash of every engine source (``backend/_c``), the interface header
-(:func:`amble.backend.abi.c_header`), the compiler, its version and the flags, and the
+(:func:`amble.backend.abi.c_header`) and the table of integrators
+(:func:`~amble.backend.abi.c_steppers`), the compiler, its version and the flags, and the
 capacity. An object whose bytes do not match is rebuilt; every file is written under a temporary
 name and renamed, so processes building at once each end with a valid object. A model library's
 own key (:func:`amble.backend.cache.structure_key`) covers all of these inputs, since the capacity
@@ -95,6 +96,7 @@ def _sources_digest() -> str:
         if f.suffix in (".c", ".h"):
             h.update(f.name.encode() + b"\0" + f.read_bytes())
     h.update(abi.c_header().encode())
+    h.update(abi.c_steppers().encode())
     return h.hexdigest()
 
 
@@ -123,6 +125,7 @@ def build(d: Path, cap: int, tc: Toolchain) -> Path:
     with build_directory(d) as work:
         tmpd = str(work)
         (work / "amble_abi.h").write_text(abi.c_header())
+        (work / "amble_steppers.h").write_text(abi.c_steppers())
         out = work / "runtime.o"
         cmd = [*cc.split(), *tc.flags, "-std=c99", "-Werror=implicit-function-declaration", "-fPIC",
                f"-D{CAPACITY_MACRO}={cap}", "-I", tmpd, "-I", str(C_DIR), "-c", str(C_DIR / "runtime.c"),

@@ -19,7 +19,7 @@ from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
-from ..simulation.engine import METHODS, Options
+from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
 from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
@@ -92,7 +92,8 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     if args.time is not None and not args.time > 0:
         raise UsageError(f"--time must be positive, got {args.time}")
     drawn = bool(plot_p or anim_p)
-    s = load_model(args.model, compiled=not drawn, derivatives=args.start == "fixed-point" or args.method == "radau")
+    derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
+    s = load_model(args.model, compiled=not drawn, derivatives=derivatives)
     if out_p and any(m.inputs for m in s.modes.values()):
         s = s.full()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)
@@ -297,7 +298,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
     s.add_argument("--method", choices=METHODS, default="dop853",
-                   help="integrator: dop853 (explicit, default) or radau (implicit, for stiff models)")
+                   help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
+                        "tsit5 (explicit, 5th order)")
     s.set_defaults(func=cmd_simulate)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from ..backend import abi
 from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
 from ..backend.kernels import Kernels
 from ..errors import StateError
@@ -25,8 +26,12 @@ from ..errors import StateError
 #: this bounds the growth of the process's peak memory by the recording too.
 RECORD_BUDGET = 512 * 2**20
 
-#: Integrators, in the order of the compiled loop's IO_METHOD codes.
-METHODS = ("dop853", "radau")
+#: Integrators, by name, in the order of their codes (the table of :mod:`amble.backend.abi`).
+METHODS = tuple(name for _, name, _, _ in abi.METHODS)
+#: Per integrator: do the kernels need their derivatives (an implicit method's Newton matrix)?
+NEEDS_JACOBIAN = abi.NEEDS_JACOBIAN
+#: The integrators that give sensitivities (their stages carry the variational equations).
+SENSITIVITY_METHODS = tuple(m for m in METHODS if abi.HAS_SENSITIVITIES[m])
 
 #: Accepted integrator steps per compiled call: the loop returns this often so that Python can
 #: handle signals (Ctrl-C), then resumes exactly where it stopped.
@@ -46,7 +51,7 @@ _IO_MAXSTEPS, _IO_OUTCAP, _IO_EVCAP = IOPT["MAXSTEPS"], IOPT["OUTCAP"], IOPT["EV
 class Options:
     """Integration and outcome settings.
 
-    rtol, atol: DOP853 tolerances (relative, absolute). max_step: largest step (s, 0 = none).
+    rtol, atol: the integrator's tolerances (relative, absolute). max_step: largest step (s, 0 = none).
     max_step_time: a walker that makes no footfall for this long has ``fell`` (s, 0 = never).
     zeno_dt, zeno_events: this many consecutive events each closer than ``zeno_dt`` (s) to the
     previous one end the run as ``zeno``. max_events: hard cap on events. nsub: uniform guard
@@ -55,9 +60,11 @@ class Options:
     max_integrator_steps: cap on accepted integrator steps of a run (status
     ``max_integrator_steps``); max_steps_between_events: cap on accepted steps between two
     transitions (status ``stalled``: a stiff or chattering run). 0: no cap. method: ``"dop853"``
-    (explicit, 8th order: the default) or ``"radau"`` (Radau IIA, implicit, 5th order, with the
+    (explicit, 8th order: the default), ``"radau"`` (Radau IIA, implicit, 5th order, with the
     model's exact Jacobian in its Newton iterations: for stiff runs — high-gain controllers, stiff
-    springs — where an explicit method's step is bounded by stability rather than accuracy).
+    springs — where an explicit method's step is bounded by stability rather than accuracy) or
+    ``"tsit5"`` (Tsitouras 5(4), explicit, with a free 4th-order dense output and SciPy's RK45
+    step control: comparable with other 5th-order codes).
     """
 
     rtol: float = 1e-10
@@ -98,7 +105,7 @@ class Options:
         values = {"MAXSTEPS": 0, "MAXEVENTS": self.max_events, "OUTCAP": 0, "EVCAP": 0, "ZENON": self.zeno_events,
                   "NSUB": self.nsub, "MAXISTEPS": self.max_integrator_steps,
                   "MAXISTEPS_EV": self.max_steps_between_events, "YIELDN": YIELD_STEPS,
-                  "METHOD": METHODS.index(self.method)}
+                  "METHOD": abi.METHOD[self.method]}
         return np.array([values[f] for f in IOPT_FIELDS], dtype=np.int64)
 
 
@@ -189,12 +196,13 @@ def run(
     buf = _Buffers.take(0 if events_only else _first_rows(nxm, budget), nxm) if record else _NO_RECORDING
     if sensitivities not in (False, True, "state"):
         raise StateError(f"sensitivities must be True, False or 'state', got {sensitivities!r}")
-    if (sensitivities or opts.method != "dop853") and not k.meta.get("derivatives"):
+    if (sensitivities or NEEDS_JACOBIAN[opts.method]) and not k.meta.get("derivatives"):
         raise StateError(f"system {k.meta['name']!r}: sensitivities and the implicit integrator need the kernels "
                          "built with their derivatives: build(system, derivatives=True)")
-    if sensitivities and opts.method != "dop853":
-        # the variational equations ride on the explicit method's stages
-        raise StateError(f"sensitivities need method='dop853', not {opts.method!r}")
+    if sensitivities and not abi.HAS_SENSITIVITIES[opts.method]:
+        # the variational equations ride on an explicit method's stages
+        raise StateError(f"sensitivities need method={' or '.join(map(repr, SENSITIVITY_METHODS))}, "
+                         f"not {opts.method!r}")
     sens = _sensitivity_buffer(k, x0.size, sensitivities is True) if sensitivities else None
     sens_addr = sens.ctypes.data if sens is not None else None
     code = _YIELD

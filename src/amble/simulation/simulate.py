@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.abi import CODE, CTX
+from ..backend.abi import CODE, CTX, NEEDS_JACOBIAN
 from ..backend.kernels import Kernels, build
 from ..errors import ParameterError, StateError
 from .engine import RECORD_BUDGET, Options, Run, run
@@ -154,8 +154,9 @@ def simulate(
         the trajectory then holds without a copy (so the process's peak memory grows by about
         this much at most); a run that would record more ends as ``record_limit`` with what it has.
     method:
-        ``"dop853"`` (explicit, the default) or ``"radau"`` (implicit Radau IIA with the model's
-        exact Jacobian, for stiff systems); default that of ``options``.
+        ``"dop853"`` (explicit, the default), ``"radau"`` (implicit Radau IIA with the model's
+        exact Jacobian, for stiff systems) or ``"tsit5"`` (explicit Tsitouras 5(4)); default that
+        of ``options``.
     """
     base = options or _DEFAULT_OPTIONS
     if not isinstance(base, Options):
@@ -174,8 +175,9 @@ def simulate(
         raise StateError(f"end time must be positive and finite, got {t_end}")
     if not (sample_dt >= 0 and math.isfinite(sample_dt)):
         raise StateError(f"sample_dt must be a finite number ≥ 0 s, got {sample_dt}")
-    implicit = (method or (options.method if options else "dop853")) == "radau"
-    k = build(system, derivatives=implicit)  # the implicit integrator's Newton matrix is the exact Jacobian
+    # an implicit integrator's Newton matrix is the exact Jacobian (an unknown name is refused below)
+    jacobian = NEEDS_JACOBIAN.get(method or (options.method if options else "dop853"), False)
+    k = build(system, derivatives=jacobian)
     p = parameter_vector(k, params, system)
     mi, x = initial_state(system, k, x0, mode)
     if steps is None and t_end is None:
@@ -352,7 +354,7 @@ def _stiff_hint(r: Run, opts: Options) -> str:
         # away on both sides oscillates with an amplitude of its own), which no integrator cures
         return (f" (the state still crosses a switching surface, last at t = {last:.9g} s: it chatters "
                 f"about the switch, which a smaller step or another integrator does not cure)")
-    if opts.method != "dop853":
+    if NEEDS_JACOBIAN[opts.method]:  # already implicit
         return ""
     if h > 0 and mean > 0 and h < 1e-4 * max(r.t, 1.0):
         return (f" (steps of ~{mean:.2g} s: the system looks stiff; try the implicit integrator, "

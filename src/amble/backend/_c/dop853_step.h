@@ -1,11 +1,10 @@
 /* DOP853 (Hairer, Norsett & Wanner) as implemented in SciPy: same tableau, error norm, step-size
- * control and 7th-order dense output, so results can be compared step for step. Also the cheap
- * cubic Hermite interpolant through both step ends used to screen guards.
+ * control and 7th-order dense output, so results can be compared step for step.
  *
  * The step itself is compiled in the model's own translation unit (this file is included by
  * model_tail.h), with the right-hand side inlined into it: the stage sums and the right-hand side
- * are nearly all of a small model's integrator time. The functions are hidden, not static: the
- * runtime (runtime.c, compiled once) calls them directly inside the model's library.
+ * are nearly all of a small model's integrator time. The runtime (runtime.c, compiled once)
+ * reaches it through the hidden stepper dop853_stepper (stepper.h) inside the model's library.
  *
  * Needs from the including unit: the ST_* codes (generated from abi.py), NXMAX and
  *   int rhs(int mode, double t, const double *x, const double *p, double *dx);
@@ -14,46 +13,7 @@
 #ifndef AMBLE_DOP853_STEP_H
 #define AMBLE_DOP853_STEP_H
 #include "dop853.h"
-
-/* The state length of the step. A unit whose modes all have one length defines NX_FIXED to it, so
- * every loop over the state has a constant trip count and is unrolled by the compiler (measured:
- * the stage sums are a third of the compass gait's integrator time with a run-time length). */
-#ifdef NX_FIXED
-#define DOP_N(s) NX_FIXED
-#else
-#define DOP_N(s) ((s)->n)
-#endif
-
-static double rms_norm(int n, const double *v) {
-    double s = 0.0;
-    for (int i = 0; i < n; ++i) s += v[i] * v[i];
-    return sqrt(s / n);
-}
-
-/* Initial step size as in Hairer's / SciPy's select_initial_step. */
-AMBLE_HIDDEN double initial_step(int mode, double t, const double *y, const double *f, const double *p,
-                           double t_bound, double max_step, double rtol, double atol, int n) {
-    double sc[NXMAX], tmp[NXMAX], y1[NXMAX], f1[NXMAX];
-    double interval = fabs(t_bound - t);
-    if (interval == 0.0) return 0.0;
-    for (int i = 0; i < n; ++i) sc[i] = atol + fabs(y[i]) * rtol;
-    for (int i = 0; i < n; ++i) tmp[i] = y[i] / sc[i];
-    double d0 = rms_norm(n, tmp);
-    for (int i = 0; i < n; ++i) tmp[i] = f[i] / sc[i];
-    double d1 = rms_norm(n, tmp);
-    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
-    if (h0 > interval) h0 = interval;
-    for (int i = 0; i < n; ++i) y1[i] = y[i] + h0 * f[i];
-    if (rhs(mode, t + h0, y1, p, f1)) return 1e-6;
-    for (int i = 0; i < n; ++i) tmp[i] = (f1[i] - f[i]) / sc[i];
-    double d2 = rms_norm(n, tmp) / h0;
-    double h1;
-    if (d1 <= 1e-15 && d2 <= 1e-15) h1 = fmax(1e-6, h0 * 1e-3);
-    else h1 = pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
-    double h = fmin(100 * h0, h1);
-    h = fmin(h, interval);
-    return fmin(h, max_step);
-}
+#include "step_common.h"
 
 /* Aiming at a switching surface estimated at a fraction θ of a rejected trial: if θ > AIM_NEAR the
  * retry ends AIM_SHORT (relative) short of it, a step with every stage on the near side; the
@@ -98,8 +58,8 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
  * dop853_tableau.h), the coefficients as constants, as the dense output's below: per component the
  * additions are those of the plain sum over all stages, in its order (from 0.0, zeros skipped), so
  * the results are bitwise those of the loop over the tableau with a zero test per coefficient. */
-#define DOP_ADD_TERM(j, c) a += (c) * s->K[j][i];
-#define DOP_ADD_E(j, c5, c3) { const double k = s->K[j][i]; a5 += (c5) * k; a3 += (c3) * k; }
+#define DOP_ADD_TERM(j, c) a += (c) * d->K[j][i];
+#define DOP_ADD_E(j, c5, c3) { const double k = d->K[j][i]; a5 += (c5) * k; a3 += (c3) * k; }
 #define DOP_STEP_STAGE(st)                                                                     \
     if (!err) {                                                                                \
         for (int i = 0; i < n; ++i) {                                                          \
@@ -107,7 +67,7 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
             DOP_A##st##_TERMS(DOP_ADD_TERM)                                                    \
             ytmp[i] = s->y_old[i] + h * a;                                                     \
         }                                                                                      \
-        err = rhs(mode, t + DOP_C[st] * h, ytmp, p, s->K[st]);                                 \
+        err = rhs(mode, t + DOP_C[st] * h, ytmp, p, d->K[st]);                                 \
     }
 
 /* One accepted DOP853 step from (t_old, y_old) with f_old known. Returns 0, or a status.
@@ -125,10 +85,10 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
  * *h_kink: the step size proposed before a switch spoiled the step (the size to resume with
  * after its crossing), or 0 if none did. g_new, gd_new (or NULL): the mode's surfaces and their
  * rates at the accepted step's end, computed with its last stage (rhs_surfaces). */
-AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, double rtol, double atol,
-                    double max_step, double *h_abs, const double *sw0, const double *swd0, double *h_kink,
-                    double *g_new, double *gd_new) {
-    const int n = DOP_N(s);
+static int dop_step(Step *s, int mode, const double *p, double t_bound, double rtol, double atol, double max_step,
+                    double *h_abs, const double *sw0, const double *swd0, double *h_kink, double *g_new, double *gd_new) {
+    Dop *d = (Dop *)s;
+    const int n = STEP_N(s);
     const double t = s->t_old;
     double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
     double ha = *h_abs;
@@ -144,7 +104,7 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
         if (t_new > t_bound) t_new = t_bound;
         double h = t_new - t;
         ha = fabs(h);
-        for (int i = 0; i < n; ++i) s->K[0][i] = s->f_old[i];
+        for (int i = 0; i < n; ++i) d->K[0][i] = s->f_old[i];
         int err = 0;
         DOP_STEP_STAGE(1) DOP_STEP_STAGE(2) DOP_STEP_STAGE(3) DOP_STEP_STAGE(4) DOP_STEP_STAGE(5)
         DOP_STEP_STAGE(6) DOP_STEP_STAGE(7) DOP_STEP_STAGE(8) DOP_STEP_STAGE(9) DOP_STEP_STAGE(10)
@@ -156,8 +116,8 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
             s->y[i] = s->y_old[i] + h * a;
         }
         /* the last stage, at the step's end: with the surfaces the event screening reads there */
-        if (g_new ? rhs_surfaces(mode, t + h, s->y, p, s->K[DOP_STAGES], g_new, gd_new)
-                  : rhs(mode, t + h, s->y, p, s->K[DOP_STAGES]))
+        if (g_new ? rhs_surfaces(mode, t + h, s->y, p, d->K[DOP_STAGES], g_new, gd_new)
+                  : rhs(mode, t + h, s->y, p, d->K[DOP_STAGES]))
             return ST_SINGULAR_MASS;
         double e5 = 0.0, e3 = 0.0;
         for (int i = 0; i < n; ++i) {
@@ -183,8 +143,8 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
             if (rejected && factor > 1.0) factor = 1.0;
             *h_abs = ha * factor;
             s->h = h;
-            for (int i = 0; i < n; ++i) s->f[i] = s->K[DOP_STAGES][i];
-            s->dense_ready = 0;
+            for (int i = 0; i < n; ++i) s->f[i] = d->K[DOP_STAGES][i];
+            d->dense_ready = 0;
             return 0;
         }
         rejected = 1;
@@ -211,7 +171,7 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
  * instructions (callgrind, compass gait). Per component the additions are those of the plain
  * sum over all stages, in its order (from 0.0, zeros skipped), so the result is bitwise the same;
  * the four coefficient rows are summed in one pass, each K[j] read once for all four. */
-#define DOP_ADD_D(j, c0, c1, c2, c3) { const double k = s->K[j][i]; d0 += (c0) * k; d1 += (c1) * k; \
+#define DOP_ADD_D(j, c0, c1, c2, c3) { const double k = d->K[j][i]; d0 += (c0) * k; d1 += (c1) * k; \
                                        d2 += (c2) * k; d3 += (c3) * k; }
 #define DOP_EXTRA_STAGE(st)                                                                    \
     for (int i = 0; i < n; ++i) {                                                              \
@@ -219,11 +179,12 @@ AMBLE_HIDDEN int dop_step(Dop *s, int mode, const double *p, double t_bound, dou
         DOP_A##st##_TERMS(DOP_ADD_TERM)                                                        \
         ytmp[i] = s->y_old[i] + h * a;                                                         \
     }                                                                                          \
-    if (rhs(mode, s->t_old + DOP_C[st] * h, ytmp, p, s->K[st])) return ST_SINGULAR_MASS;
+    if (rhs(mode, s->t_old + DOP_C[st] * h, ytmp, p, d->K[st])) return ST_SINGULAR_MASS;
 
-AMBLE_HIDDEN int dop_dense_prepare(Dop *s, int mode, const double *p) {
-    if (s->dense_ready || s->radau) return 0;
-    const int n = DOP_N(s);
+static int dop_dense_prepare(Step *s, int mode, const double *p) {
+    Dop *d = (Dop *)s;
+    if (d->dense_ready) return 0;
+    const int n = STEP_N(s);
     const double h = s->h;
     double ytmp[NXMAX];
     DOP_EXTRA_STAGE(13)
@@ -231,17 +192,17 @@ AMBLE_HIDDEN int dop_dense_prepare(Dop *s, int mode, const double *p) {
     DOP_EXTRA_STAGE(15)
     for (int i = 0; i < n; ++i) {
         const double dy = s->y[i] - s->y_old[i];
-        s->F[0][i] = dy;
-        s->F[1][i] = h * s->f_old[i] - dy;
-        s->F[2][i] = 2.0 * dy - h * (s->f[i] + s->f_old[i]);
+        d->F[0][i] = dy;
+        d->F[1][i] = h * s->f_old[i] - dy;
+        d->F[2][i] = 2.0 * dy - h * (s->f[i] + s->f_old[i]);
         double d0 = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
         DOP_D_TERMS(DOP_ADD_D)
-        s->F[3][i] = h * d0;
-        s->F[4][i] = h * d1;
-        s->F[5][i] = h * d2;
-        s->F[6][i] = h * d3;
+        d->F[3][i] = h * d0;
+        d->F[4][i] = h * d1;
+        d->F[5][i] = h * d2;
+        d->F[6][i] = h * d3;
     }
-    s->dense_ready = 1;
+    d->dense_ready = 1;
     return 0;
 }
 #undef DOP_EXTRA_STAGE
@@ -251,28 +212,25 @@ AMBLE_HIDDEN int dop_dense_prepare(Dop *s, int mode, const double *p) {
 /* The dense output at θ = x of the last step: Horner in x and 1 − x alternately (x first, from
  * the highest of the DOP_INTERP coefficient rows), written out; all components side by side. */
 typedef char dop_interp_rows_are_7[DOP_INTERP == 7 ? 1 : -1]; /* a compile error otherwise */
-static inline void dense_at(const Dop *restrict s, double x, double *restrict out) {
-    const int n = DOP_N(s);
-    if (s->radau) {
-        for (int i = 0; i < n; ++i) out[i] = s->y_old[i] + x * (s->Q[0][i] + x * (s->Q[1][i] + x * s->Q[2][i]));
-        return;
-    }
+static inline void dense_at(const Dop *restrict d, double x, double *restrict out) {
+    const Step *s = &d->b;
+    const int n = STEP_N(s);
     const double y1 = 1.0 - x;
     for (int i = 0; i < n; ++i) {
-        double y = (0.0 + s->F[6][i]) * x; /* 0.0 + keeps the sign of a zero as the loop had it */
-        y = (y + s->F[5][i]) * y1;
-        y = (y + s->F[4][i]) * x;
-        y = (y + s->F[3][i]) * y1;
-        y = (y + s->F[2][i]) * x;
-        y = (y + s->F[1][i]) * y1;
-        y = (y + s->F[0][i]) * x;
+        double y = (0.0 + d->F[6][i]) * x; /* 0.0 + keeps the sign of a zero as the loop had it */
+        y = (y + d->F[5][i]) * y1;
+        y = (y + d->F[4][i]) * x;
+        y = (y + d->F[3][i]) * y1;
+        y = (y + d->F[2][i]) * x;
+        y = (y + d->F[1][i]) * y1;
+        y = (y + d->F[0][i]) * x;
         out[i] = y + s->y_old[i];
     }
 }
 
 /* The dense output of the last step at t. */
-AMBLE_HIDDEN void dop_dense_eval(const Dop *restrict s, double t, double *restrict out) {
-    dense_at(s, (t - s->t_old) / s->h, out);
+static void dop_dense_eval(const Step *restrict s, double t, double *restrict out) {
+    dense_at((const Dop *)s, (t - s->t_old) / s->h, out);
 }
 
 /* Rows of the dense output at the grid times t0 + k·dt, k = k0 … k1 − 1, that lie after t (those
@@ -280,28 +238,28 @@ AMBLE_HIDDEN void dop_dense_eval(const Dop *restrict s, double t, double *restri
  * of out_x of NXMAX entries, padded with NaN. Returns the number of rows written. In the model's
  * unit, not the runtime, so that the interpolant is inlined and, with NXMAX and NX_FIXED
  * constants, a row is a few stores instead of a loop with a test per entry. */
-AMBLE_HIDDEN int64_t dop_dense_rows(const Dop *restrict s, double t0, double dt, int64_t k0, int64_t k1, double t,
-                                    double *restrict out_t, double *restrict out_x) {
-    const int n = DOP_N(s);
+static int64_t dop_dense_rows(const Step *restrict s, double t0, double dt, int64_t k0, int64_t k1, double t,
+                              double *restrict out_t, double *restrict out_x) {
+    const int n = STEP_N(s);
     int64_t r = 0;
     for (int64_t k = k0; k < k1; ++k) {
         const double tk = t0 + k * dt;
         if (tk <= t) continue;
         double *row = out_x + r * NXMAX;
-        dense_at(s, (tk - s->t_old) / s->h, row);
+        dense_at((const Dop *)s, (tk - s->t_old) / s->h, row);
         for (int i = n; i < NXMAX; ++i) row[i] = NAN;
         out_t[r++] = tk;
     }
     return r;
 }
 
-/* Cubic Hermite through both step ends: cheap, for spotting sign changes inside a step. */
-AMBLE_HIDDEN void hermite_eval(const Dop *s, double theta, double *out) {
-    const double h = s->h;
-    double t2 = theta * theta, t3 = t2 * theta;
-    double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + theta, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
-    for (int i = 0; i < DOP_N(s); ++i)
-        out[i] = h00 * s->y_old[i] + h10 * h * s->f_old[i] + h01 * s->y[i] + h11 * h * s->f[i];
-}
+static size_t dop_size(void) { return sizeof(Dop); }
+static void dop_init(Step *s) { ((Dop *)s)->dense_ready = 0; }
+static void dop_restart(Step *s) { (void)s; } /* a one-step method: nothing outlives a step */
+
+static const Tableau dop_tableau = {DOP_STAGES, DOP_STAGES_EXT, DOP_A, DOP_B, DOP_C};
+
+AMBLE_HIDDEN const Stepper dop853_stepper = {dop_size, dop_init, dop_restart, dop_step, dop_dense_prepare,
+                                             dop_dense_eval, dop_dense_rows, 7, &dop_tableau};
 
 #endif

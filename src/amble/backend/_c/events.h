@@ -2,11 +2,11 @@
  *
  * A step is screened by sampling each guard of the mode at a few times inside it (a uniform grid
  * plus, per guard, the extremum of the cubic through g and ġ at both ends) on the cheap Hermite
- * interpolant; only if some guard changes sign in its direction is the 7th-order dense output
+ * interpolant; only if some guard changes sign in its direction is the method's dense output
  * built, the samples redone on it, and each bracketed crossing refined by regula falsi (locate).
  * The event is the earliest crossing whose enabling condition holds there.
  *
- * Needs from the including unit: dop853.h, the ST_* codes, NTR, NSWMAX, NSUB_MAX, MODE_NTR,
+ * Needs from the including unit: stepper.h, the ST_* codes, NTR, NSWMAX, NSUB_MAX, MODE_NTR,
  * MODE_TR0, MODE_NSW, TR_DIR and guards, guards_dot, switches, switches_dot, enabled.
  */
 #ifndef AMBLE_EVENTS_H
@@ -76,9 +76,9 @@ static int crosses(int dir, double ga, double gb) {
 }
 
 /* Guard k of `mode` along the dense output at time t. */
-static double guard_at(const Dop *s, int mode, int k, double t, const double *p, double *xbuf) {
+static double guard_at(const Step *s, int mode, int k, double t, const double *p, double *xbuf) {
     double g[NTR1];
-    dop_dense_eval(s, t, xbuf);
+    step_dense_eval(s, t, xbuf);
     surfaces(mode, t, xbuf, p, g);
     return g[k];
 }
@@ -88,7 +88,7 @@ static double guard_at(const Dop *s, int mode, int k, double t, const double *p,
  * g_replaced, or halved — Illinois — if that is not positive); returns a time on the far side of
  * the crossing, within ~1e-14 relative. Compass gait, 400 crossings: 6.5 evaluations on average,
  * none above 10 (the Illinois method: 11.2 on average, up to 27). */
-static double locate(const Dop *s, int mode, int k, int dir, double ta, double ga, double tb,
+static double locate(const Step *s, int mode, int k, int dir, double ta, double ga, double tb,
                      double gb, const double *p) {
     double xbuf[NXMAX];
     int side = 0;
@@ -149,11 +149,11 @@ static int sample_times(double h, int ntr, int nsub, const double *g_old, const 
 }
 
 /* Guards at the inner sample times, on the Hermite interpolant (dense = 0) or the dense output. */
-static void sample_guards(const Dop *s, int mode, const double *p, double t, int ns, const double *th,
+static void sample_guards(const Step *s, int mode, const double *p, double t, int ns, const double *th,
                           int dense, double gs[][NTR1]) {
     double xs[NXMAX];
     for (int j = 1; j < ns - 1; ++j) {
-        if (dense) dop_dense_eval(s, t + s->h * th[j], xs);
+        if (dense) step_dense_eval(s, t + s->h * th[j], xs);
         else hermite_eval(s, th[j], xs);
         surfaces(mode, t + s->h * th[j], xs, p, gs[j]);
     }
@@ -169,7 +169,7 @@ static int any_crossing(int mode, int ns, double gs[][NTR1]) {
 
 /* The earliest enabled crossing over the samples (dense output ready): returns its surface index
  * within the mode (or -1) and sets *t_ev, x_ev and *from (the surface's value before it). */
-static int first_enabled_crossing(const Dop *s, int mode, const double *p, double t, double t_new, int ns,
+static int first_enabled_crossing(const Step *s, int mode, const double *p, double t, double t_new, int ns,
                                   const double *th, double gs[][NTR1], double *t_ev, double *x_ev,
                                   double *from, double t_min) {
     const int nsf = n_surf(mode);
@@ -184,7 +184,7 @@ static int first_enabled_crossing(const Dop *s, int mode, const double *p, doubl
             if (tr >= *t_ev) break;
             double xr[NXMAX];
             if (tr >= t_new) { tr = t_new; for (int i = 0; i < s->n; ++i) xr[i] = s->y[i]; }
-            else dop_dense_eval(s, tr, xr);
+            else step_dense_eval(s, tr, xr);
             if (surf_enabled(mode, k, tr, xr, p, t_min)) {
                 *t_ev = tr;
                 ev_k = k;
@@ -346,8 +346,8 @@ static void onto_far_side(int mode, int k, double t, double *x, const double *p,
 static double pre_side(int dir, double g0) { return dir < 0 ? 1.0 : dir > 0 ? -1.0 : (g0 >= 0.0 ? 1.0 : -1.0); }
 
 /* θ ∈ (0, 1) of the extremum of surface k inside the step, where ġ (ġ0 at θ = 0, ġ1 at θ = 1, of
- * opposite signs) vanishes along the 7th-order dense output: Illinois on ġ = ∇g · f(x(θ)). */
-static double extremum_theta(const Dop *s, int mode, int k, const double *p, double gd0, double gd1) {
+ * opposite signs) vanishes along the dense output: Illinois on ġ = ∇g · f(x(θ)). */
+static double extremum_theta(const Step *s, int mode, int k, const double *p, double gd0, double gd1) {
     double xa[NXMAX], fa[NXMAX], gd[NTR1];
     double ta = 0.0, tb = 1.0, fa0 = gd0, fb0 = gd1;
     int side = 0;
@@ -356,7 +356,7 @@ static double extremum_theta(const Dop *s, int mode, int k, const double *p, dou
         tm = (fa0 * tb - fb0 * ta) / (fa0 - fb0);
         if (!(tm > ta && tm < tb)) tm = 0.5 * (ta + tb);
         double t = s->t_old + s->h * tm;
-        dop_dense_eval(s, t, xa);
+        step_dense_eval(s, t, xa);
         if (rhs(mode, t, xa, p, fa)) break;
         surfaces_dot(mode, t, xa, fa, p, gd);
         if ((gd[k] < 0.0) == (fa0 < 0.0)) {
@@ -377,7 +377,7 @@ static double extremum_theta(const Dop *s, int mode, int k, const double *p, dou
  * decides: deeper than the integration tolerance (gtol, in g's units) it is a crossing and its
  * time becomes a sample; otherwise (a tangency, or no crossing) the surface has no event in this
  * step (skip[k] = 1). Returns the new number of samples. */
-static int refine_dips(Dop *s, int mode, const double *p, double gtol_abs, double gtol_rel, const double *g_old,
+static int refine_dips(Step *s, int mode, const double *p, double gtol_abs, double gtol_rel, const double *g_old,
                        const double *gd_old, const double *g_new, const double *gd_new, int ns, double *th,
                        int *skip) {
     for (int k = 0; k < n_surf(mode); ++k) {
@@ -385,7 +385,7 @@ static int refine_dips(Dop *s, int mode, const double *p, double gtol_abs, doubl
         if (!(sd * g_old[k] > 0.0 && sd * g_new[k] > 0.0 && sd * gd_old[k] < 0.0 && sd * gd_new[k] > 0.0)) continue;
         double te = extremum_theta(s, mode, k, p, gd_old[k], gd_new[k]);
         double xe[NXMAX], ge[NTR1];
-        dop_dense_eval(s, s->t_old + s->h * te, xe);
+        step_dense_eval(s, s->t_old + s->h * te, xe);
         surfaces(mode, s->t_old + s->h * te, xe, p, ge);
         double tol = gtol_abs + gtol_rel * fmax(fabs(g_old[k]), fabs(g_new[k]));
         if (sd * ge[k] < -tol && ns < NSAMP_MAX) {
@@ -402,7 +402,7 @@ static int refine_dips(Dop *s, int mode, const double *p, double gtol_abs, doubl
 /* Event of the step just taken from (t, g_old, gd_old) to (t_new, g_new, gd_new: ġ at t_new):
  * sets *ev_k (guard index within the mode, or -1), *t_ev and x_ev. Returns 0 or
  * ST_SINGULAR_MASS (the dense output could not be built). */
-static int find_event(Dop *s, int mode, const double *p, int nsub, double t, double t_new,
+static int find_event(Step *s, int mode, const double *p, int nsub, double t, double t_new,
                       const double *g_old, const double *gd_old, const double *g_new, const double *gd_new,
                       int *ev_k, double *t_ev, double *x_ev, double *from, double t_min,
                       double gtol_abs, double gtol_rel) {
@@ -422,7 +422,7 @@ static int find_event(Dop *s, int mode, const double *p, int nsub, double t, dou
     for (int k = 0; k < ntr; ++k) { gs[0][k] = g_old[k]; gs[ns - 1][k] = g_new[k]; }
     sample_guards(s, mode, p, t, ns, th, 0, gs);
     if (!any_crossing(mode, ns, gs) && !dips) return 0;
-    if (dop_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
+    if (step_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
     if (dips) {
         int ns0 = ns;
         ns = refine_dips(s, mode, p, gtol_abs, gtol_rel, g_old, gd_old, g_new, gd_new, ns, th, skip);

@@ -4,7 +4,7 @@
  * The sizes are run-time values here, not macros of constants: the runtime is compiled once for
  * every model of a capacity bucket. Local arrays sized by them are C99 variable-length arrays of
  * the model's own length (stack use as if the runtime were compiled for the model); the
- * integrator's state (Dop) holds AMBLE_NXCAP entries. The row stride of caller-owned buffers
+ * integrator's state (Step, stepper.h) holds AMBLE_NXCAP entries. The row stride of caller-owned buffers
  * (recorded rows, batches, the sensitivity layout of abi.py) is the model's NXMAX.
  *
  * Needs from the including unit: amble_core.h (AMBLE_HIDDEN).

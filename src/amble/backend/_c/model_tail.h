@@ -7,8 +7,9 @@
  *     TR_* are defined, not static, by the generated code);
  *   its kernels, as thin wrappers amble_k_* of the unit's static dispatchers (which the compiler
  *     inlines into them);
- *   the DOP853 step (dop853_step.h), compiled here so that the right-hand side is inlined into
- *     the stage loop and, with NX_FIXED, the state loops have constant trip counts.
+ *   the DOP853 step (dop853_step.h) and the pieces every method's step shares (step_common.h),
+ *     compiled here so that the right-hand side is inlined into the stage loop and, with
+ *     NX_FIXED, the state loops have constant trip counts.
  * The runtime was compiled for AMBLE_NXCAP state entries of the integrator's arrays: the symbol
  * amble_nxcap_<AMBLE_NXCAP> it references exists only in a unit generated for that capacity, so a
  * model linked with the runtime of another capacity fails to link instead of misreading.

@@ -5,11 +5,12 @@
  * collocation dense output. The Newton matrix uses the exact flow Jacobian ∂f/∂x of the model
  * (rhs_jac, generated from the symbolic equations), refreshed when Newton converges slowly.
  *
- * An accepted step fills the Dop fields the event code reads (t_old, h, y_old, y, f_old, f and,
- * through Dop.radau and Dop.Q, the dense output), so guards are screened and located exactly as
- * for DOP853.
+ * An accepted step fills the Step the event code reads (t_old, h, y_old, y, f_old, f) and the
+ * collocation cubic, its dense output, so guards are screened and located exactly as for DOP853.
+ * Compiled in the runtime; its stepper is radau_stepper (stepper.h).
  *
- * Needs from the including unit: dop853.h, amble_core.h's LU, NXMAX, SC, rhs, rhs_jac.
+ * Needs from the including unit: stepper.h, events.h (the surfaces at a step's end),
+ * amble_core.h's LU, NXMAX, SC, rhs, rhs_jac.
  */
 #ifndef AMBLE_RADAU_H
 #define AMBLE_RADAU_H
@@ -43,7 +44,15 @@ typedef struct {
     double h_abs_old, err_old;                     /* for the predictive step-size controller */
 } Radau;
 
-/* The workspace of radau_attach, sized for the model (the caller's variable-length arrays). */
+/* The state of a run: the last step, its dense output y_old + Q0 θ + Q1 θ² + Q2 θ³
+ * (θ = (t − t_old)/h), the Newton matrices; the workspace of radau_attach follows it. */
+typedef struct {
+    Step b; /* first: the state is reached from its Step */
+    double Q[3][AMBLE_NXCAP];
+    Radau r;
+} RadauState;
+
+/* The workspace of radau_attach, sized for the model. */
 static int radau_doubles(void) { return NXMAX * SC + 5 * NXMAX * NXMAX; }
 static int radau_ints(void) { return 3 * NXMAX; }
 
@@ -134,9 +143,15 @@ static int radau_newton(Radau *r, int mode, const double *p, double t, const dou
     return 0;
 }
 
-/* One accepted Radau IIA step from (t_old, y_old) with f_old known; same contract as dop_step. */
-static int radau_step(Dop *s, Radau *r, int mode, const double *p, double t_bound, double rtol, double atol,
-                      double max_step, double *h_abs_io) {
+/* One accepted Radau IIA step from (t_old, y_old) with f_old known (stepper.h); no aiming at
+ * switches (sw0, swd0 unread, *h_kink 0). The surfaces at its end are evaluated afresh. */
+static int radau_step(Step *s, int mode, const double *p, double t_bound, double rtol, double atol,
+                      double max_step, double *h_abs_io, const double *sw0, const double *swd0, double *h_kink,
+                      double *g_new, double *gd_new) {
+    RadauState *rs = (RadauState *)s;
+    Radau *r = &rs->r;
+    (void)sw0, (void)swd0;
+    *h_kink = 0.0;
     const int n = s->n;
     const double t = s->t_old;
     const double min_step = 10.0 * fabs(nextafter(t, INFINITY) - t);
@@ -166,7 +181,7 @@ static int radau_step(Dop *s, Radau *r, int mode, const double *p, double t_boun
             for (int i = 0; i < n; ++i) {
                 if (r->have_sol) {
                     const double th = 1.0 + RAD_C[k] * h / s->h;
-                    Z[k][i] = th * (s->Q[0][i] + th * (s->Q[1][i] + th * s->Q[2][i])) - (s->Q[0][i] + s->Q[1][i] + s->Q[2][i]);
+                    Z[k][i] = th * (rs->Q[0][i] + th * (rs->Q[1][i] + th * rs->Q[2][i])) - (rs->Q[0][i] + rs->Q[1][i] + rs->Q[2][i]);
                 } else {
                     Z[k][i] = 0.0;
                 }
@@ -233,13 +248,56 @@ static int radau_step(Dop *s, Radau *r, int mode, const double *p, double t_boun
         for (int i = 0; i < n; ++i) {
             s->y[i] = ynew[i];
             s->f[i] = fnew[i];
-            for (int k = 0; k < 3; ++k) s->Q[k][i] = Z[0][i] * RAD_P[0][k] + Z[1][i] * RAD_P[1][k] + Z[2][i] * RAD_P[2][k];
+            for (int k = 0; k < 3; ++k) rs->Q[k][i] = Z[0][i] * RAD_P[0][k] + Z[1][i] * RAD_P[1][k] + Z[2][i] * RAD_P[2][k];
         }
-        s->radau = 1;
-        s->dense_ready = 1;
         r->have_sol = 1;
+        surfaces(mode, t + h, s->y, p, g_new);
+        surfaces_dot(mode, t + h, s->y, s->f, p, gd_new);
         return 0;
     }
 }
+
+static size_t radau_size(void) {
+    return sizeof(RadauState) + (size_t)radau_doubles() * sizeof(double) + (size_t)radau_ints() * sizeof(int);
+}
+
+static void radau_init(Step *s) {
+    RadauState *rs = (RadauState *)s;
+    double *w = (double *)(rs + 1);
+    radau_attach(&rs->r, w, (int *)(w + radau_doubles()));
+    radau_reset(&rs->r);
+}
+
+static void radau_restart(Step *s) { radau_reset(&((RadauState *)s)->r); }
+
+/* the collocation cubic is the dense output: always ready */
+static int radau_dense_prepare(Step *s, int mode, const double *p) { (void)s, (void)mode, (void)p; return 0; }
+
+static inline void radau_dense_at(const RadauState *rs, double x, double *out) {
+    const Step *s = &rs->b;
+    for (int i = 0; i < s->n; ++i) out[i] = s->y_old[i] + x * (rs->Q[0][i] + x * (rs->Q[1][i] + x * rs->Q[2][i]));
+}
+
+static void radau_dense_eval(const Step *s, double t, double *out) {
+    radau_dense_at((const RadauState *)s, (t - s->t_old) / s->h, out);
+}
+
+static int64_t radau_dense_rows(const Step *s, double t0, double dt, int64_t k0, int64_t k1, double t, double *out_t,
+                                double *out_x) {
+    int64_t r = 0;
+    for (int64_t k = k0; k < k1; ++k) {
+        const double tk = t0 + k * dt;
+        if (tk <= t) continue;
+        double *row = out_x + r * NXMAX;
+        radau_dense_at((const RadauState *)s, (tk - s->t_old) / s->h, row);
+        for (int i = s->n; i < NXMAX; ++i) row[i] = NAN;
+        out_t[r++] = tk;
+    }
+    return r;
+}
+
+/* the initial step's exponent as DOP853's (runs keep the steps they had) */
+static const Stepper radau_stepper = {radau_size, radau_init, radau_restart, radau_step, radau_dense_prepare,
+                                      radau_dense_eval, radau_dense_rows, 7, NULL};
 
 #endif

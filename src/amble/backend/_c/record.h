@@ -2,7 +2,7 @@
  * NXMAX) and event rows (time, transition, pre- and post-event states). Counters and capacities
  * are int64_t, shared with NumPy int64 arrays.
  *
- * Needs from the including unit: dop853.h, the ST_* and CX_* codes, NXMAX.
+ * Needs from the including unit: stepper.h, the ST_* and CX_* codes, NXMAX.
  */
 #ifndef AMBLE_RECORD_H
 #define AMBLE_RECORD_H
@@ -43,13 +43,13 @@ static int64_t grid_end(const double *ctx, double sample_dt, int64_t k0, double 
 
 /* Rows of the output grid k0 .. k1-1 of the step from t, on its dense output (samples at or
  * before t were written by the previous step). The rows are written by the model's unit
- * (dop_dense_rows), where the state length and the row stride are constants. Returns 0 or
+ * (the method's dense_rows), where the state length and the row stride are constants. Returns 0 or
  * ST_SINGULAR_MASS. */
-static int put_grid_rows(Rec *r, Dop *s, int mode, const double *p, const double *ctx, double sample_dt,
+static int put_grid_rows(Rec *r, Step *s, int mode, const double *p, const double *ctx, double sample_dt,
                          int64_t k0, int64_t k1, double t) {
-    if (dop_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
+    if (step_dense_prepare(s, mode, p)) return ST_SINGULAR_MASS;
     const int64_t first = *r->n_out;
-    const int64_t m = dop_dense_rows(s, ctx[CX_GRID_T0], sample_dt, k0, k1, t, r->out_t + first, r->out_x + first * NXMAX);
+    const int64_t m = s->m->dense_rows(s, ctx[CX_GRID_T0], sample_dt, k0, k1, t, r->out_t + first, r->out_x + first * NXMAX);
     for (int64_t k = first; k < first + m; ++k) r->out_mode[k] = mode;
     *r->n_out = first + m;
     return 0;

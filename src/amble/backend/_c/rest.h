@@ -24,7 +24,7 @@ static int settled(int k, int n, const double *x, const double *g, const double 
  * reset, record the event and the post-event row, and re-arm the guards of the new mode in
  * g_old, gd_old. Returns -1 (the run goes on) or a status ST_* that ends it. The caller has made
  * room for one more row and one more event. */
-static int come_to_rest(int tr, double t, const double *p, Dop *s, int *mode, double *ctx, Rec *rec,
+static int come_to_rest(int tr, double t, const double *p, Step *s, int *mode, double *ctx, Rec *rec,
                         int recording, int ev_recording, double *g_old, double *gd_old) {
     const int rt = TR_REST[tr];
     double xr[NXMAX];

@@ -1,6 +1,7 @@
 /* Forward sensitivities of a hybrid run: S = ∂x(t)/∂(x0, p), carried through flows and events.
  *
- * Flow: each accepted step is taken again for the pair (x, S) with the same DOP853 stages,
+ * Flow: each accepted step is taken again for the pair (x, S) with the same stages of the
+ * method's explicit tableau (its stepper's, stepper.h; a method without one has none),
  *   K_S = J_x S + J_p, J = ∂f/∂(x, p) from rhs_jac at every stage state,
  * so S is the derivative of the discrete flow over the accepted step sizes (the step sizes are
  * chosen on x alone). A step cut at an event is taken again up to just before it (a switching
@@ -17,7 +18,7 @@
  * (state columns 0 … nx0−1, parameter j at NXMAX + j), then one row dτ of the last transition,
  * then the numbers of state and parameter columns carried; its offsets SENS_S, SENS_TAU,
  * SENS_NCS, SENS_NCP and SENS_SIZE come from the table in amble/backend/abi.py.
- * Needs from the including unit: dop853.h, events.h, rhs_jac, surfaces_grad, reset_jac.
+ * Needs from the including unit: stepper.h, events.h, rhs_jac, surfaces_grad, reset_jac.
  */
 #ifndef AMBLE_SENSITIVITY_H
 #define AMBLE_SENSITIVITY_H
@@ -52,14 +53,14 @@ static void jac_times(int n, Cols cl, const double *J, const double *S, double *
     }
 }
 
-/* One DOP853 step of (y, S) from (t0, y0, S) over h; S is overwritten, y1 gets the state. */
-static int sens_advance(int mode, const double *p, Cols cl, double t0, double h, const double *y0, double *S,
-                        double *y1) {
-    const int n = MODE_NX[mode];
-    double K[DOP_STAGES][NXMAX], KS[DOP_STAGES][NXMAX * SC], J[NXMAX * SC];
+/* One step of (y, S) on tableau tb from (t0, y0, S) over h; S is overwritten, y1 gets the state. */
+static int sens_advance(const Tableau *tb, int mode, const double *p, Cols cl, double t0, double h, const double *y0,
+                        double *S, double *y1) {
+    const int n = MODE_NX[mode], ns = tb->stages;
+    double K[ns][NXMAX], KS[ns][NXMAX * SC], J[NXMAX * SC];
     double ytmp[NXMAX], Stmp[NXMAX * SC];
-    for (int st = 0; st < DOP_STAGES; ++st) {
-        const double *a = DOP_A + st * DOP_STAGES_EXT;
+    for (int st = 0; st < ns; ++st) {
+        const double *a = tb->a + st * tb->stride;
         for (int i = 0; i < n; ++i) {
             double acc = 0.0;
             for (int j = 0; j < st; ++j) acc += a[j] * K[j][i];
@@ -70,17 +71,17 @@ static int sens_advance(int mode, const double *p, Cols cl, double t0, double h,
                 Stmp[i * SC + c] = S[i * SC + c] + h * as;
             });
         }
-        int err = sens_jac(mode, t0 + DOP_C[st] * h, ytmp, p, cl, K[st], J);
+        int err = sens_jac(mode, t0 + tb->c[st] * h, ytmp, p, cl, K[st], J);
         if (err) return err;
         jac_times(n, cl, J, Stmp, KS[st]);
     }
     for (int i = 0; i < n; ++i) {
         double acc = 0.0;
-        for (int j = 0; j < DOP_STAGES; ++j) acc += DOP_B[j] * K[j][i];
+        for (int j = 0; j < ns; ++j) acc += tb->b[j] * K[j][i];
         y1[i] = y0[i] + h * acc;
         FOR_COLS(cl, c, {
             double as = 0.0;
-            for (int j = 0; j < DOP_STAGES; ++j) as += DOP_B[j] * KS[j][i * SC + c];
+            for (int j = 0; j < ns; ++j) as += tb->b[j] * KS[j][i * SC + c];
             S[i * SC + c] += h * as;
         });
     }
@@ -90,7 +91,7 @@ static int sens_advance(int mode, const double *p, Cols cl, double t0, double h,
 /* S carried from the start of the current step (t0, y0) to an event at t_ev inside it. Sets
  * fm to the flow just before the event (at the dense-output state x_ev; for a switching surface
  * extrapolated from its near side). */
-static int sens_to_event(const Dop *s, int mode, const double *p, double t0, const double *y0, double t_ev,
+static int sens_to_event(const Step *s, int mode, const double *p, double t0, const double *y0, double t_ev,
                          const double *x_ev, int is_switch, double *sens, double *fm) {
     const Cols cl = sens_cols(sens);
     double *S = sens + SENS_S;
@@ -100,7 +101,7 @@ static int sens_to_event(const Dop *s, int mode, const double *p, double t0, con
     if (delta > 0.5 * span) delta = 0.5 * span;
     double ya[NXMAX], J[NXMAX * SC], KS[NXMAX * SC], fa[NXMAX];
     int st = 0;
-    if (span - delta > 0.0 && (st = sens_advance(mode, p, cl, t0, span - delta, y0, S, ya))) return st;
+    if (span - delta > 0.0 && (st = sens_advance(s->m->tableau, mode, p, cl, t0, span - delta, y0, S, ya))) return st;
     if (!(span - delta > 0.0)) for (int i = 0; i < n; ++i) ya[i] = y0[i];
     /* the bridge over the last δ: S += δ (J_x S + J_p) at the near-side state */
     if ((st = sens_jac(mode, t_ev - delta, ya, p, cl, fa, J))) return st;
@@ -113,9 +114,9 @@ static int sens_to_event(const Dop *s, int mode, const double *p, double t0, con
     /* the near-side branch of a jumping right-hand side: f(x(t_ev − δ)) and f(x(t_ev − 2δ)) on the
      * dense output, extrapolated linearly to t_ev (error second order in δ) */
     double xb[NXMAX], f1[NXMAX], f2[NXMAX];
-    dop_dense_eval(s, t_ev - delta, xb);
+    step_dense_eval(s, t_ev - delta, xb);
     if (rhs(mode, t_ev - delta, xb, p, f1)) return ST_SINGULAR_MASS;
-    dop_dense_eval(s, t_ev - 2.0 * delta, xb);
+    step_dense_eval(s, t_ev - 2.0 * delta, xb);
     if (rhs(mode, t_ev - 2.0 * delta, xb, p, f2)) return ST_SINGULAR_MASS;
     for (int i = 0; i < n; ++i) fm[i] = 2.0 * f1[i] - f2[i];
     return 0;
