@@ -19,11 +19,12 @@ from .version import __version__  # noqa: F401  (amble.__version__)
 #: public name → module (relative to this package) that defines it
 _WHERE: dict[str, str] = {
     **dict.fromkeys(("Equations", "derive"), ".derivation.equations"),
-    **dict.fromkeys(("contact_force", "unilateral_contact"), ".derivation.resting"),
+    **dict.fromkeys(("contact_force", "unilateral_contact"), ".derivation.contact"),
     **dict.fromkeys(("AmbleError", "CompileError", "ConvergenceError", "ExpressionError", "ModelError", "OutputError",
                      "ParameterError",
                      "SchedulerError", "SimulationError", "StateError"), ".errors"),
-    **dict.fromkeys(("RoundFoot", "rolling_centre", "round_foot"), ".modelling.contact"),
+    **dict.fromkeys(("RoundFoot", "compliant_contact", "distance_along_slope", "heel_strike", "height_above_slope",
+                     "rolling_centre", "round_foot"), ".modelling.contact"),
     **dict.fromkeys(("NONNEGATIVE", "POSITIVE", "Domain", "interval"), ".modelling.domain"),
     **dict.fromkeys(("R3", "R", "Rx", "Ry", "Rz", "t", "vector"), ".modelling.geometry"),
     **dict.fromkeys(("Explicit", "Guard", "HybridSystem", "Impact", "Lock"), ".modelling.hybrid"),
@@ -32,8 +33,7 @@ _WHERE: dict[str, str] = {
     "parse": ".modelling.text",
     **dict.fromkeys(("base_relabel", "stance_feet_walker"), ".modelling.stance_feet"),
     "Joint": ".modelling.tree",
-    **dict.fromkeys(("Walker", "distance_along_slope", "heel_strike", "height_above_slope", "joint_lock", "walker"),
-                    ".modelling.walker"),
+    **dict.fromkeys(("Walker", "joint_lock", "walker"), ".modelling.walker"),
     **dict.fromkeys(("Options", "run", "walk_many"), ".simulation.engine"),
     "parameter_vector": ".simulation.simulate",
     "build": ".backend.kernels",
@@ -74,8 +74,8 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
+    from .derivation.contact import contact_force, unilateral_contact  # noqa: F401
     from .derivation.equations import Equations, derive  # noqa: F401
-    from .derivation.resting import contact_force, unilateral_contact  # noqa: F401
     from .errors import (  # noqa: F401
         AmbleError,
         CompileError,
@@ -87,7 +87,15 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
         SimulationError,
         StateError,
     )
-    from .modelling.contact import RoundFoot, rolling_centre, round_foot  # noqa: F401
+    from .modelling.contact import (  # noqa: F401
+        RoundFoot,
+        compliant_contact,
+        distance_along_slope,
+        heel_strike,
+        height_above_slope,
+        rolling_centre,
+        round_foot,
+    )
     from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval  # noqa: F401
     from .modelling.geometry import R3, R, Rx, Ry, Rz, t, vector  # noqa: F401
     from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock  # noqa: F401
@@ -95,14 +103,7 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
     from .modelling.sampled import sample_and_hold  # noqa: F401
     from .modelling.stance_feet import base_relabel, stance_feet_walker  # noqa: F401
     from .modelling.tree import Joint  # noqa: F401
-    from .modelling.walker import (  # noqa: F401
-        Walker,
-        distance_along_slope,
-        heel_strike,
-        height_above_slope,
-        joint_lock,
-        walker,
-    )
+    from .modelling.walker import Walker, joint_lock, walker  # noqa: F401
     from .simulation.engine import Options  # noqa: F401
     from .simulation.simulate import simulate  # noqa: F401
     from .simulation.trajectory import Event, Trajectory  # noqa: F401

@@ -51,7 +51,8 @@ def test_key_ignores_parameter_defaults():
 
 def test_key_covers_the_generating_sources():
     names = {str(f.relative_to(cache._PKG)) for f in cache.source_files()}
-    for need in ("modelling/model.py", "modelling/hybrid.py", "modelling/walker.py", "derivation/equations.py",
+    for need in ("modelling/model.py", "modelling/hybrid.py", "modelling/walker.py", "modelling/contact/footfall.py",
+                 "derivation/equations.py", "derivation/contact.py",
                  "derivation/impact.py", "backend/codegen.py", "backend/abi.py", "backend/cache.py",
                  "backend/_c/hybrid.c", "backend/_c/events.h", "backend/_c/dop853.h", "backend/_c/record.h"):
         assert need in names

@@ -5,8 +5,9 @@ a simulated gait this module asks, from Newton's law for the whole robot (indepe
 equations of motion that produced the motion):
 
 * the **ground reaction** at the stance foot ``F = Σ mᵢ aᵢ − m g`` (the total mass times the
-  acceleration of the centre of mass, less gravity): its normal component ``F_n`` (along the
-  slope's normal) must be positive, and the friction ratio ``|F_t|/F_n`` below ``μ``;
+  acceleration of the centre of mass, less gravity; :mod:`amble.modelling.contact.reaction`):
+  its normal component ``F_n`` (along the slope's normal) must be positive, and the friction
+  ratio ``|F_t|/F_n`` below ``μ``;
 * the **swing foot** must stay above the ground between footfalls (the height of the impacting
   point along the slope's normal, away from the first and last ``margin`` of each step);
 * at each **footfall** the ground's impulse ``ΔP = m (v⁺_com − v⁻_com)`` must push (positive
@@ -14,8 +15,7 @@ equations of motion that produced the motion):
   the footfall positive) — otherwise the impact assumed is not the one that happens;
 * every **input** within its declared limit.
 
-The accelerations come from the compiled right-hand side at each sample; point masses (including
-the bodies of a rigid-body tree) carry the linear momentum.
+The accelerations come from the compiled right-hand side at each sample.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import AmbleError, ModelError
+from ..modelling.contact import reaction
 
 #: default friction coefficient of the stance foot
 MU = 0.7
@@ -67,21 +68,15 @@ class GaitCheck:
         return out
 
 
-def _momentum_functions(model: Any) -> tuple[Any, Any, float]:
-    """NumPy functions of ``(q, q̇, q̈, params)``: the total ``Σ mᵢ aᵢ`` and ``Σ mᵢ vᵢ``."""
+def _momentum_functions(model: Any) -> tuple[Any, Any]:
+    """NumPy functions of the ground's force ``(q, q̇, q̈, params)`` and of the total linear
+    momentum ``(q, q̇, params)`` (:mod:`amble.modelling.contact.reaction`)."""
     hit = _FN.get(model)
     if hit is None:
         q, qd = model.q, model.qd
-        qdd = [sp.Symbol(f"{s}__ddot", real=True) for s in q]
-        P = sp.zeros(model.dims, 1)
-        for name, m in model.masses.items():
-            P += m * model.points[name]
-        v = model.jacobian(P) * sp.Matrix(qd)
-        a = v.jacobian(q) * sp.Matrix(qd) + v.jacobian(qd) * sp.Matrix(qdd)
-        args = [*q, *qd, *qdd, *model.params]
-        mass = sum(model.masses.values(), sp.Integer(0))
-        hit = (sp.lambdify(args, list(a), "numpy", cse=True), sp.lambdify([*q, *qd, *model.params], list(v), "numpy"),
-               sp.lambdify(list(model.params), mass, "numpy"))
+        args = [*q, *qd, *reaction.accelerations(model), *model.params]
+        hit = (sp.lambdify(args, list(reaction.ground_force(model)), "numpy", cse=True),
+               sp.lambdify([*q, *qd, *model.params], list(reaction.linear_momentum(model)), "numpy"))
         _FN[model] = hit
     return hit
 
@@ -104,15 +99,13 @@ def ground_reaction(traj: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if rows.size == 0:
             continue
         model = system.modes[mname]
-        acc, _, mass = _momentum_functions(model)
+        force, _ = _momentum_functions(model)
         pm = [traj.parameters[str(s)] for s in model.params]
-        gsubs = {s: traj.parameters[str(s)] for s in model.params}
-        gvec = np.array([float(e.subs(gsubs)) for e in model.gravity_vector])
         n = len(model.q)
         for r in rows:
             x = traj.x[r, : 2 * n]
             qdd = k.rhs(mname, float(traj.t[r]), x, p)[n:]
-            f = np.asarray(acc(*x, *qdd, *pm), float) - float(mass(*pm)) * gvec
+            f = np.asarray(force(*x, *qdd, *pm), float)
             F[r] = f if model.dims == 3 else (f[0], 0.0, f[1])
     Fn = F @ n3
     Ft = np.linalg.norm(F - Fn[:, None] * n3[None, :], axis=1)
@@ -147,8 +140,8 @@ def check_gait(traj: Any, mu: float = MU, margin: float = MARGIN) -> GaitCheck:
     impulses, lifts = [], []
     for e in traj.step_events:
         src, dst = system.modes[e.source], system.modes[e.target]
-        _, vs, _ = _momentum_functions(src)
-        _, vd, _ = _momentum_functions(dst)
+        _, vs = _momentum_functions(src)
+        _, vd = _momentum_functions(dst)
         dP = (np.asarray(vd(*e.x_post, *[traj.parameters[str(s)] for s in dst.params]), float)
               - np.asarray(vs(*e.x_pre, *[traj.parameters[str(s)] for s in src.params]), float))
         impulses.append(float(dP @ (n3 if dP.size == 3 else n3[[0, 2]])))

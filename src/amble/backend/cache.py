@@ -79,7 +79,7 @@ _PKG = Path(__file__).resolve().parents[1]
 C_DIR = _PKG / "backend" / "_c"
 
 #: Python sources that shape the generated code (relative to the package), besides ``backend/_c``.
-_SOURCE_GLOBS = ("backend/*.py", "derivation/*.py", "modelling/*.py")
+_SOURCE_GLOBS = ("backend/*.py", "derivation/**/*.py", "modelling/**/*.py")
 
 #: id(system) → (weak reference, fingerprint, structural hash)
 _STRUCT: dict[int, tuple[weakref.ref, tuple, str]] = {}

@@ -248,6 +248,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     """
     from ..derivation.equations import derive
     from ..derivation.impact import impulse_data
+    from ..modelling.contact import reaction
     from ..modelling.model import t as time
 
     ca = casadi_module()
@@ -285,10 +286,10 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     res = T.matrix(Mc) @ a + T.matrix(hc) - T.matrix(eq.Gamma) - (T.matrix(B) @ u if nu else 0)
     args = [q, qd, a, u, tt, p]
     dynamics = ca.Function("dynamics", args, [res], ["q", "qd", "a", "u", "t", "p"], ["residual"])
-    # stance-foot force from the total linear momentum (rotational inertia carries none)
-    mt = sum(m.masses.values(), sp.Integer(0))
-    mom = sum((mi * m.points[k] for k, mi in m.masses.items()), sp.zeros(d, 1))
-    com = T.matrix(mom)
+    # the ground's force on the stance foot (amble.modelling.contact.reaction), differentiated
+    # by CasADi: (Σ mᵢ pᵢ)¨ − (Σ mᵢ) g
+    mt = reaction.total_mass(m)
+    com = T.matrix(reaction.mass_moment(m))
     vel = ca.jtimes(com, q, qd)
     acc = ca.jtimes(vel, q, qd) + ca.jtimes(vel, qd, a)
     force = acc - T(mt) * T.matrix(m.gravity_vector)

@@ -16,7 +16,7 @@ coordinates — and transitions between them. A transition has
   or no reset and a terminal status (``fell``): the run ends there.
 
 A unilateral contact with restitution (``amble.unilateral_contact``, derived in
-:mod:`amble.derivation.resting`) adds a resting mode and three transitions declared by
+:mod:`amble.derivation.contact`) adds a resting mode and three transitions declared by
 :meth:`HybridSystem.resting_contact`: the impact, the rest transition the compiled loop takes
 instead of a ``zeno`` end, and the lift-off.
 

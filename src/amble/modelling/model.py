@@ -15,7 +15,7 @@ Conventions: SI units, angles in radians. The world frame has ``x`` forward, ``y
 (3D only), ``z`` up; gravity points along ``-z`` unless :meth:`Model.gravity` says otherwise.
 2D models live in the x–z plane. A slope is a *rotated ground*, not a rotated gravity: positions
 and angles are written against the true vertical, and the walking surface is a plane through
-the stance foot descending along ``+x`` (see :mod:`amble.modelling.walker`). That keeps angles in the
+the stance foot descending along ``+x`` (see :mod:`amble.modelling.contact.ground`). That keeps angles in the
 convention of the thesis and of Drake (from the vertical, positive in the walking direction).
 """
 

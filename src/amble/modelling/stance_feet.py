@@ -27,11 +27,12 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
+from .contact import heel_strike, height_above_slope
 from .dag import dag_subs
 from .hybrid import Guard
 from .model import Model
 from .tree import RigidTree, _mat3, _matmul, rpy_matrix
-from .walker import Walker, heel_strike, height_above_slope
+from .walker import Walker
 
 
 def _base_chain(model: Model) -> list:

@@ -1,9 +1,8 @@
-"""Walkers on a slope: heel-strike guards, impact resets and falls from a few declarations.
+"""Walkers on a slope: a footfall, joint locks and falls from a few declarations.
 
 The walking surface is a plane through the stance foot (the origin of every step's frame)
-descending along ``+x`` at angle ``slope``. Its unit normal is ``n = (sin γ, cos γ)`` in 2D
-(``(sin γ, 0, cos γ)`` in 3D) and the downhill direction along it is ``d = (cos γ, −sin γ)``.
-A point's height above the ground is ``n·p``; it is ahead of the stance foot when ``d·p > 0``.
+descending along ``+x`` at angle ``slope`` (:mod:`amble.modelling.contact.ground`); the footfall
+is a contact's impact (:func:`amble.modelling.contact.heel_strike`).
 """
 
 from __future__ import annotations
@@ -13,12 +12,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import sympy as sp
-
 from ..errors import ModelError
-from .contact import RoundFoot
+from .contact import RoundFoot, heel_strike, height_above_slope
 from .domain import interval
-from .hybrid import Guard, HybridSystem, Impact, Lock
+from .hybrid import Guard, HybridSystem, Lock
 from .model import Model
 
 _AXES = {"x": 0, "y": 1, "z": 2}
@@ -67,60 +64,6 @@ class Walker(HybridSystem):
         if isinstance(s, (int, float)):
             return float(s)
         return float(params.get(str(s), self.parameters.get(str(s), 0.0)))
-
-
-def _vec2(model: Model, a: Any, b: Any) -> sp.Matrix:
-    return sp.Matrix([a, b]) if model.dims == 2 else sp.Matrix([a, 0, b])
-
-
-def height_above_slope(model: Model, point: str, slope: Any) -> sp.Expr:
-    """Height (m) of a named point above the slope plane through the origin, along its normal."""
-    n = _vec2(model, sp.sin(slope), sp.cos(slope))
-    return (n.T * model.points[point])[0, 0]
-
-
-def distance_along_slope(model: Model, point: str, slope: Any) -> sp.Expr:
-    """Distance (m) of a named point ahead of the origin, measured downhill along the slope."""
-    d = _vec2(model, sp.cos(slope), -sp.sin(slope))
-    return (d.T * model.points[point])[0, 0]
-
-
-#: A footfall needs the foot ahead of the stance foot by this fraction of the model's size.
-STEP_MARGIN = 1e-6
-
-
-def model_size(model: Model) -> sp.Expr:
-    """A length of the model in its current configuration: the root mean square distance of its
-    named points from the origin (the stance foot) — the scale of an enabling margin."""
-    pts = list(model.points.values())
-    if not pts:
-        return sp.Integer(1)
-    return sp.sqrt(sum(((p.T * p)[0, 0] for p in pts), sp.Integer(0)) / len(pts))
-
-
-def heel_strike(model: Model, foot: str | RoundFoot, slope: Any, relabel: Mapping[Any, Any],
-                margin: Any = None, stance: str | RoundFoot | None = None) -> tuple[Guard, Impact]:
-    """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot
-    by more than ``margin`` (default :data:`STEP_MARGIN` × :func:`model_size`, so that legs
-    passing each other — the foot at the stance foot up to round-off — are no footfall),
-    followed by a plastic impact and the leg relabelling.
-
-    ``foot`` is a point (a point foot) or a :class:`~amble.modelling.contact.RoundFoot`: then its
-    contact point meets the slope and the impact constrains the material point of the foot at
-    the contact (its ``rolling`` point, which also becomes the next step's origin). ``stance``
-    names the stance foot's contact (a point or a ``RoundFoot``) that the foot must be ahead
-    of; by default the origin, where a point stance foot stands.
-    """
-    contact = foot.contact if isinstance(foot, RoundFoot) else foot
-    if margin is None:
-        margin = STEP_MARGIN * model_size(model)
-    ahead = distance_along_slope(model, contact, slope)
-    if stance is not None:
-        ahead -= distance_along_slope(model, stance.contact if isinstance(stance, RoundFoot) else stance, slope)
-    # unevaluated: deciding ``ahead > margin`` asks sympy for signs of the whole expression, which
-    # for a rigid-body tree's positions (shared graphs) takes minutes; the compiled code decides it
-    guard = Guard(height_above_slope(model, contact, slope), -1, sp.StrictGreaterThan(ahead, margin, evaluate=False))
-    return guard, Impact(foot.rolling if isinstance(foot, RoundFoot) else foot, relabel)
 
 
 def joint_lock(constraint: Any, relabel: Mapping[Any, Any] | None = None) -> tuple[Guard, Lock]:

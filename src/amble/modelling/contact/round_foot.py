@@ -4,7 +4,7 @@ A planar foot is an arc of radius ``r`` about a centre ``C`` fixed on its leg; t
 with the body angle ``θ`` (rad, from the vertical, positive leaning downhill, the convention
 of :func:`~amble.modelling.geometry.R`). The ground is the plane through the origin with unit
 normal ``n = (sin γ, cos γ)`` and downhill direction ``d = (cos γ, −sin γ)`` (see
-:mod:`.walker`). While the arc touches the ground its contact is the lowest point of the arc,
+:mod:`.ground`). While the arc touches the ground its contact is the lowest point of the arc,
 ``C − r n``.
 
 **Rolling without slip.** The contact advances by ``r Δθ`` along the slope as the foot turns by
@@ -39,8 +39,9 @@ from typing import Any
 
 import sympy as sp
 
-from ..errors import ModelError
-from .model import Model
+from ...errors import ModelError
+from ..model import Model
+from .ground import slope_downhill, slope_normal
 
 
 @dataclass(frozen=True)
@@ -54,16 +55,6 @@ class RoundFoot:
     contact: str
     rolling: str
     radius: Any
-
-
-def slope_normal(slope: Any) -> sp.Matrix:
-    """Unit normal ``n = (sin γ, cos γ)`` of the slope (planar models: ``x`` downhill, ``z`` up)."""
-    return sp.Matrix([sp.sin(slope), sp.cos(slope)])
-
-
-def slope_downhill(slope: Any) -> sp.Matrix:
-    """Unit vector ``d = (cos γ, −sin γ)`` along the slope, pointing downhill."""
-    return sp.Matrix([sp.cos(slope), -sp.sin(slope)])
 
 
 def rolling_centre(angle: Any, radius: Any, slope: Any) -> sp.Matrix:
@@ -81,7 +72,7 @@ def round_foot(model: Model, name: str, centre: Any, angle: Any, radius: Any, sl
 
     Names the points ``name`` (the contact ``C − r n``), ``name_centre`` (linked to ``link``
     when given, for drawing) and ``name_rolling`` (see the module docstring), and returns them
-    as a :class:`RoundFoot` for :func:`~amble.modelling.walker.heel_strike` and
+    as a :class:`RoundFoot` for :func:`~amble.modelling.contact.footfall.heel_strike` and
     :func:`~amble.modelling.walker.walker`.
     """
     if model.dims != 2:
