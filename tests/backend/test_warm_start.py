@@ -156,8 +156,14 @@ def test_the_compiled_system_travels_to_workers_and_answers_like_the_model(cache
     elsewhere.__setstate__((state[0], {True: (tmp_path / "nowhere.so", {})}, state[2]))
     assert elsewhere.compiled_kernels() is None
     assert math.isclose(_fall_time(elsewhere), math.sqrt(2 * 2.0 / 9.81), rel_tol=1e-9)
-    # what it does not hold, the full model answers (built on demand)
-    assert set(warm.modes["ball"].masses) == set(full.modes["ball"].masses) == {"p"}
+    # what it does not hold it does not pretend to hold: the declared system is asked for by name
+    for holder, name in ((warm, "slope"), (warm.modes["ball"], "masses"), (warm.transitions[0], "guard")):
+        with pytest.raises(AttributeError, match=rf"compiled numbers only, not '{name}': its .symbolic\(\)"):
+            getattr(holder, name)
+    assert set(warm.symbolic().modes["ball"].masses) == set(full.symbolic().modes["ball"].masses) == {"p"}
+    assert full.symbolic() is full
+    with pytest.warns(DeprecationWarning, match=r"symbolic\(\)"):
+        assert warm.full() is warm.symbolic()
     from amble import ParameterError, simulate
 
     for system in (full, warm):

@@ -91,7 +91,7 @@ def ground_reaction(traj: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The stance foot's ground reaction per sample, ``F = Σ mᵢ aᵢ − m g`` (N, (N, 3), world
     axes of the step's frame; 2D models have y = 0), its normal component ``F_n`` and the norm
     of its tangential part ``|F_t|`` along the ground of a walker."""
-    system, k, p = traj.system, traj.kernels, traj.params
+    system, k, p = traj.system.symbolic(), traj.kernels, traj.params  # the masses are declared, symbolic
     n3 = _normal(system, traj.parameters)
     F = np.full((len(traj.t), 3), np.nan)
     for mi, mname in enumerate(traj.mode_names):
@@ -117,9 +117,9 @@ def check_gait(traj: Any, mu: float = MU, margin: float = MARGIN) -> GaitCheck:
     of whole steps (e.g. ``LimitCycle.trajectory()``)."""
     if not mu > 0:
         raise AmbleError(f"friction coefficient μ must be positive, got {mu}")
-    system = traj.system
-    if system is None or getattr(system, "hip", None) is None:
+    if traj.system is None or getattr(traj.system, "hip", None) is None:
         raise ModelError("check_gait needs a trajectory of a walker")
+    system = traj.system.symbolic()
     k, p = traj.kernels, traj.params
     n3 = _normal(system, traj.parameters)
     _, F_n, F_t = ground_reaction(traj)

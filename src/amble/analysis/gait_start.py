@@ -89,7 +89,7 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
 def default_guess_kind(system: HybridSystem) -> str:
     """``"stand"`` for a system whose first mode has a feedback law (virtual constraints or a
     control law of its inputs), else ``"passive"``."""
-    m = system.modes[system.mode_names[0]]
+    m = system.symbolic().modes[system.mode_names[0]]  # the feedback law is declared, symbolic
     law = getattr(m, "control_law", None)
     controlled = getattr(m, "virtual", None) is not None or (law is not None and any(e != 0 for e in law))
     return "stand" if controlled else "passive"

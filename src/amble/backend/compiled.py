@@ -8,15 +8,19 @@ the frame (``frame_change``), the walker's hip. :func:`amble.backend.kernels.bui
 kernels. It is made by the warm-start index (:mod:`amble.backend.index`) from a small JSON
 (:func:`describe`) written when the model was last built.
 
-Anything else a caller asks of it (the symbolic model of a mode, a walker's slope expression) is
-answered by the full system, built on first such use from the same source: the answer is always
-that of the model, the price is the SymPy import that the compiled system otherwise avoids.
+It holds nothing symbolic and does not pretend to: asking it for what only the declaration has
+(a mode's masses, a walker's slope expression) raises :class:`AttributeError` naming
+:meth:`CompiledSystem.symbolic`, which builds the declared system from the same source (the
+price is the SymPy import that the compiled system otherwise avoids).
+:meth:`~amble.modelling.hybrid.HybridSystem.symbolic` is the same call on a declared system, so a
+caller that needs the symbols asks any system the same way.
 
 Units: those the model declares (``unit``); times in the model's time unit.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -62,17 +66,22 @@ def describe(system: HybridSystem) -> dict[str, Any]:
     }
 
 
-class _Info:
-    """Attributes from a dict; a name it lacks is asked of the full system's counterpart."""
+def _missing(owner: str, name: str) -> AttributeError:
+    return AttributeError(f"{owner} holds the compiled numbers only, not {name!r}: its .symbolic() "
+                          "is the declared system, built from the same source")
 
-    def __init__(self, values: Mapping[str, Any], full: Callable[[], Any]) -> None:
+
+class _Info:
+    """The declared numbers of a mode or a transition (attributes from a dict)."""
+
+    def __init__(self, what: str, values: Mapping[str, Any]) -> None:
         self.__dict__.update(values)
-        self._full = full
+        self._what = what
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("__"):
+        if name.startswith("_"):
             raise AttributeError(name)
-        return getattr(self._full(), name)
+        raise _missing(self._what, name)
 
 
 class CompiledSystem:
@@ -105,11 +114,11 @@ class CompiledSystem:
         self.max_step_time: float = info["max_step_time"]
         self.hip: str | None = info["hip"]
         self.mirror: str | None = info["mirror"]
-        self.modes = {mode: _Info({"inputs": m["inputs"], "state_names": m["state_names"]},
-                                  lambda mode=mode: self.full().modes[mode])
+        self.modes = {mode: _Info(f"mode {mode!r} of compiled system {self.name!r}",
+                                  {"inputs": m["inputs"], "state_names": m["state_names"]})
                       for mode, m in info["modes"].items()}
-        self.transitions = [_Info(tr, lambda i=i: self.full().transitions[i])
-                            for i, tr in enumerate(info["transitions"])]
+        self.transitions = [_Info(f"transition {tr['name']!r} of compiled system {self.name!r}", tr)
+                            for tr in info["transitions"]]
         self._kernels: dict[bool, Kernels] = {}
         for derivatives, (so, meta) in libraries.items():
             k = Kernels(so, meta)
@@ -123,11 +132,16 @@ class CompiledSystem:
         at hand has them."""
         return self._kernels.get(True) or (None if derivatives else self._kernels.get(False))
 
-    def full(self) -> HybridSystem:
-        """The full, symbolic system (built on first use, from the same source)."""
+    def symbolic(self) -> HybridSystem:
+        """The declared, symbolic system (built on first use, from the same source)."""
         if self._system is None:
             self._system = self._loader()
         return self._system
+
+    def full(self) -> HybridSystem:
+        """Deprecated name of :meth:`symbolic`."""
+        warnings.warn("CompiledSystem.full() is now CompiledSystem.symbolic()", DeprecationWarning, stacklevel=2)
+        return self.symbolic()
 
     # ------------------------------------------------------------------ HybridSystem's queries
     @property
@@ -145,7 +159,7 @@ class CompiledSystem:
     def unit(self, name: str) -> str:
         """Unit of a state variable or parameter by name (``""`` if none is declared)."""
         units = self._info["units"]
-        return units[name] if name in units else self.full().unit(name)
+        return units[name] if name in units else self.symbolic().unit(name)
 
     def frame_change(self, transition: str) -> tuple[str | None, tuple[float, float, float]]:
         """The point whose pre-event position becomes the new origin (or ``None``) and the
@@ -167,13 +181,12 @@ class CompiledSystem:
 
     def slope_value(self, params: Mapping[str, float]) -> float:
         """A walker's slope at these parameters (rad), from the full system."""
-        return self.full().slope_value(params)
+        return self.symbolic().slope_value(params)
 
-    # ------------------------------------------------------------------ everything else
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
             raise AttributeError(name)
-        return getattr(self.full(), name)
+        raise _missing(f"compiled system {self.name!r}", name)
 
     def __getstate__(self) -> tuple:
         return self._state  # a worker process reopens the libraries (ctypes handles do not travel)

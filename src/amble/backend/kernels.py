@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import CompileError, ModelError, StateError
 from . import abi, cache
 from .cache import cache_dir, structure_key
+from .compiled import CompiledSystem
 
 if TYPE_CHECKING:  # loading a cached library imports no SymPy
     from ..modelling.hybrid import HybridSystem
@@ -45,12 +46,11 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
     A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
     found by the warm-start index) is served those; without the ones asked for, its full system
     is built."""
-    carried = getattr(type(system), "compiled_kernels", None)
-    if carried is not None:
-        k = carried(system, derivatives)
+    if isinstance(system, CompiledSystem):
+        k = system.compiled_kernels(derivatives)
         if k is not None:
             return k
-        system = system.full()
+        system = system.symbolic()
     served = (id(system), derivatives, cache.fingerprint(system), *cache.settings())
     hit = _SERVED.get(served)
     if hit is not None and hit[0]() is system:

@@ -95,7 +95,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
     s = load_model(args.model, compiled=not drawn, derivatives=derivatives)
     if out_p and any(m.inputs for m in s.modes.values()):
-        s = s.full()  # the inputs written per sample come from the symbolic control law
+        s = s.symbolic()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     steps = args.steps if (args.steps is not None or args.time is not None) else 20
@@ -156,7 +156,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
         from ..analysis.gait_check import check_gait
 
-        lc.hybrid_system = s.full()  # the checks read the symbolic model (contact forces, the control law)
+        lc.hybrid_system = s.symbolic()  # the checks read the symbolic model (contact forces, the control law)
 
         # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
         gait = lc.trajectory(steps=lc.period)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import numbers
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -196,11 +197,16 @@ class HybridSystem(Revised):
                 out[k] = v
         return out
 
-    def full(self) -> HybridSystem:
-        """The symbolic system: this one. A system known only by its compiled library
+    def symbolic(self) -> HybridSystem:
+        """The declared, symbolic system: this one. A system known only by its compiled library
         (:class:`~amble.backend.compiled.CompiledSystem`) builds it here on first use, so code that
         needs the symbols (a control law, contact forces) asks any system the same way."""
         return self
+
+    def full(self) -> HybridSystem:
+        """Deprecated name of :meth:`symbolic`."""
+        warnings.warn("HybridSystem.full() is now HybridSystem.symbolic()", DeprecationWarning, stacklevel=2)
+        return self.symbolic()
 
     def check_parameters(self, values: Mapping[str, float]) -> None:
         """Raise :class:`ParameterError` for a value outside its parameter's declared domain."""

@@ -54,9 +54,9 @@ def input_names(system: Any) -> list[str]:
 
 
 def _rows(traj: Trajectory, which: int) -> dict[str, np.ndarray]:
-    system = traj.system
-    if system is None:
+    if traj.system is None:
         raise AmbleError("this trajectory carries no system; inputs need the model's control law")
+    system = traj.system.symbolic()  # the control law is symbolic
     names = input_names(system)
     out = {n: np.full(len(traj.t), np.nan) for n in names}
     params = traj.parameters
@@ -129,7 +129,7 @@ def cost_of_transport(traj: Trajectory) -> float:
     import sympy as sp
 
     params = traj.parameters
-    model = system.modes[traj.mode_names[0]]
+    model = system.symbolic().modes[traj.mode_names[0]]  # masses and gravity are declared, symbolic
     subs = {s: params[str(s)] for s in model.params}
     mass = float(sum(model.masses.values(), sp.Integer(0)).subs(subs))
     g = float(sp.sqrt(sum((c ** 2 for c in model.gravity_vector), sp.Integer(0))).subs(subs))
