@@ -103,9 +103,9 @@ def test_no_source_file_is_too_long(suffix):
 #: Public methods of the declaration classes that only read (properties are reads by nature).
 _READS = {
     "Names": {"symbol_table", "parse", "domain", "unit", "dot", "symbol"},
-    "Actuators": {"input_unit", "input_matrix", "dynamics"},
+    "Actuators": {"input_unit", "input_matrix", "dynamics", "mass_and_bias"},
     "Model": {"dt", "diff", "jacobian", "point_jacobian", "point_velocity", "from_urdf", "constrained", "validate"},
-    "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names", "full"},
+    "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names", "full", "symbolic"},
     "Walker": {"slope_value", "frame_change"},
 }
 

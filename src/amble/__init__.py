@@ -36,7 +36,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("Walker", "joint_lock", "walker"), ".modelling.walker"),
     **dict.fromkeys(("Options", "run", "walk_many"), ".simulation.engine"),
     "parameter_vector": ".simulation.simulate",
-    "build": ".backend.kernels",
+    "compiled": ".backend.kernels",
     **dict.fromkeys(("ReturnMap", "find_fixed_point"), ".analysis.poincare"),
     "Section": ".analysis.section",
     "linearize": ".analysis.linearize",
@@ -60,7 +60,17 @@ if "IPython" in _sys.modules:  # in a notebook, ``import amble`` registers the r
     _importlib.import_module(".viz.notebook", __name__).register()
 
 
+#: old public name → its new name (each kept, with a warning, for one release)
+_RENAMED: dict[str, str] = {"build": "compiled"}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _RENAMED:
+        import warnings
+
+        new = _RENAMED[name]
+        warnings.warn(f"amble.{name} is now amble.{new}", DeprecationWarning, stacklevel=2)
+        return __getattr__(new)
     where = _WHERE.get(name)
     if where is None:
         raise AttributeError(f"module 'amble' has no attribute {name!r}")

@@ -98,7 +98,7 @@ def test_a_torque_cancelling_gravity_lets_a_pendulum_turn_uniformly():
     m.point("bob", l * R(th), mass=2.0, link="pivot")
     m.gravity(9.81)
     u = m.actuator("motor", on=th)
-    _, h = m.dynamics()
+    _, h = m.mass_and_bias()
     m.control({u: h[0]})
     s = HybridSystem("pendulum", m)
     tr = simulate(s, [0.3, 1.25], t_end=2.0, sample_dt=0.1)

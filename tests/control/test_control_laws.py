@@ -25,7 +25,7 @@ def test_computed_torque_is_one_line_and_makes_the_error_linear():
     """u = B⁻¹(M v + h) with v = −k_p q − k_d q̇ gives q̈ = v exactly: each coordinate is a
     critically damped oscillator, q(t) = (q₀ + (q̇₀ + ω q₀) t) e^{−ωt} with ω = 4 rad/s."""
     m, q, u = _double_pendulum()
-    M, h = m.dynamics()
+    M, h = m.mass_and_bias()
     w = 4.0
     v = sp.Matrix([-w**2 * qi - 2 * w * m.dot(qi) for qi in q])
     m.control(dict(zip(u, m.input_matrix().inv() * (M * v + h))))

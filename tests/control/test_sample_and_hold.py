@@ -49,7 +49,7 @@ def test_bad_rates_and_laws():
     m.point("pivot", (0, 0))
     m.point("bob", R(th), mass=1.0, link="pivot")
     u = m.actuator("motor", on=th)
-    _, h = m.dynamics()
+    _, h = m.mass_and_bias()
     m.control({u: h[0]})
     with pytest.raises(ModelError, match="sample-and-hold"):
         sample_and_hold(HybridSystem("dyn", m), 100)

@@ -14,19 +14,18 @@ import ctypes
 import threading
 import weakref
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
 from ..errors import CompileError, ModelError, StateError
 from . import abi, cache
 from .cache import cache_dir, structure_key
-from .compiled import CompiledSystem
 
 if TYPE_CHECKING:  # loading a cached library imports no SymPy
     from ..modelling.hybrid import HybridSystem
 
-__all__ = ["Kernels", "build", "cache_dir", "structure_key"]
+__all__ = ["Kernels", "build", "cache_dir", "compiled", "structure_key"]
 
 _LOADED: dict[str, Kernels] = {}
 
@@ -35,8 +34,18 @@ _iptr = ctypes.POINTER(ctypes.c_int)
 _i64ptr = ctypes.POINTER(ctypes.c_int64)
 
 
-def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
-    """Compiled kernels of a system, from the in-process cache, the disk cache, or a fresh build.
+@runtime_checkable
+class CarriesKernels(Protocol):
+    """A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`):
+    those it holds, else its declared system to build them from."""
+
+    def compiled_kernels(self, derivatives: bool = False) -> Kernels | None: ...
+
+    def symbolic(self) -> HybridSystem: ...
+
+
+def compiled(system: HybridSystem, derivatives: bool = False) -> Kernels:
+    """The compiled kernels of a system, from the in-process cache, the disk cache, or a fresh build.
 
     ``derivatives``: also the derivative kernels (flow and reset Jacobians, guard gradients) that
     sensitivity runs, exact return-map Jacobians and the implicit integrator need. They are
@@ -46,7 +55,7 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
     A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
     found by the warm-start index) is served those; without the ones asked for, its full system
     is built."""
-    if isinstance(system, CompiledSystem):
+    if isinstance(system, CarriesKernels):
         k = system.compiled_kernels(derivatives)
         if k is not None:
             return k
@@ -71,6 +80,10 @@ def build(system: HybridSystem, derivatives: bool = False) -> Kernels:
 #: took longer than the rest of a short :func:`~amble.simulation.simulate.simulate` call's
 #: checks together. Weak: a served system is not kept alive by this table.
 _SERVED: dict[tuple, tuple[weakref.ref, Kernels]] = {}
+
+
+#: the name of :func:`compiled` inside the package
+build = compiled
 
 
 def _load(system: HybridSystem, derivatives: bool) -> Kernels:

@@ -7,7 +7,7 @@ leg angles acts with ``+u`` on the swing leg and ``−u`` on the stance leg. An 
 (N·m) when what it drives is an angle and a force (N) when it is a length.
 
 A control law gives inputs as expressions of the state, the time and the parameters. It may
-also use the model's own dynamics, ``M, h = model.dynamics()`` — matrices of placeholder
+also use the model's own dynamics, ``M, h = model.mass_and_bias()`` — matrices of placeholder
 symbols that :func:`amble.derive` replaces by the derived ``M(q)`` and ``h(q, q̇)`` — so
 computed torque is one line: ``model.control(dict(zip(u, Binv * (M * v + h))))``. Point
 positions, Jacobians (``model.jacobian(model.points[name])``) and velocities
@@ -19,6 +19,7 @@ to ``[−limit, limit]`` (a ``Min``/``Max`` whose kinks the simulation locates a
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -117,9 +118,14 @@ class Actuators(Names):
         return sp.Matrix([[sp.diff(a.on, qi) for a in self.actuators] for qi in self.q])
 
     def dynamics(self) -> tuple[sp.Matrix, sp.Matrix]:
+        """Deprecated name of :meth:`mass_and_bias`."""
+        warnings.warn("Model.dynamics() is now Model.mass_and_bias()", DeprecationWarning, stacklevel=2)
+        return self.mass_and_bias()
+
+    def mass_and_bias(self) -> tuple[sp.Matrix, sp.Matrix]:
         """``(M, h)`` for a control law: placeholder matrices (n × n and n × 1) that
         :func:`amble.derive` replaces by the mass matrix and the bias ``h = C q̇ + G`` of
-        ``M q̈ + h = Γ + B u``."""
+        ``M q̈ + h = Γ + B u`` (the numbers at a state are ``Kernels.dynamics``)."""
         n = len(self.q)
         if not self.derived_placeholders:
             for i in range(n):

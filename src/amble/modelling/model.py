@@ -367,7 +367,7 @@ class Model(Actuators):
         out._forces = [jac.T * put(f) for f in self._forces]
         out._g, out._g_dir = self._g, self._g_dir
         if any(e.free_symbols & set(self.derived_placeholders) for e in self._laws.values()):
-            raise ModelError(f"model {self.name!r}: a control law written with dynamics() cannot be carried "
+            raise ModelError(f"model {self.name!r}: a control law written with mass_and_bias() cannot be carried "
                              "into a constrained model; declare it on that model")
         self._copy_actuators(out, subs, vsubs)
         return out
