@@ -10,6 +10,7 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from ..errors import AmbleError, ModelError, OutputError
 
@@ -114,8 +115,21 @@ def writable_path(path: str | None, suffixes: Sequence[str], what: str) -> Path 
     return p
 
 
-def load_model(name: str, *, compiled: bool = False, derivatives: bool = False):
-    """A library model by name, or the system of a model file ``path/to/file.py[:callable]``.
+def robot_options(args: Any) -> dict[str, Any]:
+    """``--base`` and ``--fixed-base`` of a command, for :func:`load_model`; a :class:`UsageError`
+    when they are given with a model that is not a robot file."""
+    from ..models import is_robot_file
+
+    base, fixed = getattr(args, "base", None), bool(getattr(args, "fixed_base", False))
+    if (base is not None or fixed) and not is_robot_file(args.model):
+        raise UsageError(f"--base and --fixed-base apply to a robot file (.urdf), not to {_shown(args.model)}")
+    return {"base": base, "fixed_base": fixed}
+
+
+def load_model(name: str, *, compiled: bool = False, derivatives: bool = False, base: str | None = None,
+               fixed_base: bool = False):
+    """A library model by name, the system of a model file ``path/to/file.py[:callable]``, or the
+    robot of a URDF file (``base``, ``fixed_base``: :func:`amble.models.load_robot`).
 
     ``compiled``: a :class:`~amble.backend.compiled.CompiledSystem` when the warm-start index
     (:mod:`amble.backend.index`) holds the model's compiled library (with the derivative kernels
@@ -125,11 +139,32 @@ def load_model(name: str, *, compiled: bool = False, derivatives: bool = False):
     A model file that calls ``sys.exit()`` while it is loaded, or a path the operating system
     cannot look up (too long, a NUL byte), is a :class:`~amble.errors.ModelError`: the command
     would otherwise end with the file's exit code and no output, or with an internal error."""
-    from ..models import is_file_spec
+    from ..models import is_file_spec, is_robot_file
 
+    if is_robot_file(name):
+        _check_model_path(name)
+        return _load_robot(name, base, fixed_base, compiled, derivatives)
     if is_file_spec(name):
         _check_model_path(name)
     return _load(name, compiled, derivatives)  # a file's sys.exit() is load_file's ModelError
+
+
+def _load_robot(path: str, base: str | None, fixed_base: bool, compiled: bool, derivatives: bool):
+    from ..models import load_robot, source_files
+
+    build = functools.partial(load_robot, path, base=base, fixed_base=fixed_base)
+    if not compiled:
+        return build()
+    from ..backend import index
+
+    # the options shape the system: each choice of base is an index entry of its own
+    spec, sources = f"{path}?base={base or ''}&fixed={int(fixed_base)}", source_files(path)
+    hit = index.lookup(spec, sources, build, derivatives)
+    if hit is not None:
+        return hit
+    system = build()
+    index.record(spec, sources, system, sources)
+    return system
 
 
 def _load(name: str, compiled: bool, derivatives: bool):
@@ -156,7 +191,7 @@ def _shown(name: str, most: int = 80) -> str:
 def _check_model_path(spec: str) -> None:
     """:class:`ModelError` if the path of the model file ``spec`` (``path.py[:callable]``) cannot
     be looked up at all; a path that names no file is left to the loader (which says so)."""
-    path = spec if spec.endswith(".py") else spec.rpartition(":")[0]
+    path = spec if spec.endswith(".py") or not spec.rpartition(":")[0].endswith(".py") else spec.rpartition(":")[0]
     try:
         os.stat(path)
     except FileNotFoundError:

@@ -13,7 +13,7 @@ import sympy as sp
 from ..derivation.equations import derive, latex_matrix, latex_names, tidy
 from ..derivation.impact import impulse_data
 from ..modelling.hybrid import Explicit, Impact, Lock, ResetVisitor, target_exprs
-from .args import load_model
+from .args import load_model, robot_options
 
 _DIRECTION = {-1: "falling through 0", 1: "rising through 0", 0: "crossing 0"}
 
@@ -86,7 +86,7 @@ class _ResetDisplay(ResetVisitor[dict[str, Any]]):
 
 
 def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
-    s = load_model(args.model)
+    s = load_model(args.model, **robot_options(args))
     out: dict[str, Any] = {"model": args.model, "modes": {}}
     derived = {}
     for mname, m in s.modes.items():

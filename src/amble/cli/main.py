@@ -20,7 +20,7 @@ from typing import Any
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
-from .args import UsageError, _float, _Parser, load_model, parse_sets, writable_path
+from .args import UsageError, _float, _Parser, load_model, parse_sets, robot_options, writable_path
 from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
 from .output import write_output
@@ -28,8 +28,9 @@ from .output import write_output
 #: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
 MAX_PERIOD = 1000
 
-MODEL_HELP = ("a library model (see 'amble models') or a model file path/to/file.py[:callable]: the callable, "
-              "else the file's build(), else the one HybridSystem it defines")
+MODEL_HELP = ("a library model (see 'amble models'), a model file path/to/file.py[:callable]: the callable, "
+              "else the file's build(), else the one HybridSystem it defines, or a robot file path/to/robot.urdf "
+              "(floating base, or --fixed-base)")
 
 # ---------------------------------------------------------------------- commands
 def _plain(doc: str | None) -> str:
@@ -93,14 +94,17 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--time must be positive, got {args.time}")
     drawn = bool(plot_p or anim_p)
     derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
-    s = load_model(args.model, compiled=not drawn, derivatives=derivatives)
+    s = load_model(args.model, compiled=not drawn, derivatives=derivatives, **robot_options(args))
     if out_p and any(m.inputs for m in s.modes.values()):
         s = s.symbolic()  # the inputs written per sample come from the symbolic control law
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
-    steps = args.steps if (args.steps is not None or args.time is not None) else 20
+    t_end, steps = args.time, args.steps
+    if steps is None and t_end is None:  # 20 footfalls; a system that makes none runs for a second
+        walks = any(tr.step for tr in s.transitions)
+        steps, t_end = (20, None) if walks else (None, 1.0)
     # samples are recorded only for an output that shows them: a summary needs the events alone
-    tr = simulate(s, x0, params=params, steps=steps, t_end=args.time, rtol=args.rtol, atol=args.atol,
+    tr = simulate(s, x0, params=params, steps=steps, t_end=t_end, rtol=args.rtol, atol=args.atol,
                   sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
     if out_p:
@@ -148,7 +152,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     if not 1 <= args.period <= MAX_PERIOD:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
     # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
-    s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True)
+    s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True, **robot_options(args))
     params = parse_sets(args.set)
     guess = _start(s, args.guess, params) if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
@@ -272,9 +276,15 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         sp.add_argument("--json", action="store_true", help="print a JSON object on stdout")
         return sp
 
+    def robot_args(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--base", metavar="LINK", help="a robot file: the base link (default: the file's root link)")
+        sp.add_argument("--fixed-base", action="store_true",
+                        help="a robot file: the base link fixed to the world (default: floating, six coordinates)")
+
     def model_args(sp: argparse.ArgumentParser, tol: float | None) -> None:
         """``tol=None``: the tolerances default to the API's default of the chosen kind."""
         sp.add_argument("model", help=MODEL_HELP)
+        robot_args(sp)
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
         said = (f"{tol:g}" if tol is not None else
                 "the kind's: " + ", ".join(f"{kind} {v:g}" for kind, v in SWEEP_TOL.items()))
@@ -285,6 +295,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     e = add("equations", "show the derived equations of motion, and the guards and derived impact and lock maps "
                         "of the transitions")
     e.add_argument("model", help=MODEL_HELP)
+    robot_args(e)
     e.add_argument("--latex", action="store_true",
                    help="LaTeX instead of plain text (with --json: LaTeX fields beside the plain ones)")
     e.set_defaults(func=cmd_equations)
@@ -292,7 +303,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     model_args(s, Options().rtol)
     g = s.add_mutually_exclusive_group()
     g.add_argument("--steps", type=int, help="number of footfalls (default 20)")
-    g.add_argument("--time", type=float, help="end time in seconds")
+    g.add_argument("--time", type=float, help="end time in seconds (default for a system without footfalls: 1)")
     s.add_argument("--start", help="'fixed-point' or 'x0=V1,V2,...' (full state, state_names order)")
     s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")

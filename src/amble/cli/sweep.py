@@ -23,7 +23,7 @@ from ..analysis.continuation_sweep import bifurcation_rows, sweep_continuation
 from ..analysis.defaults import BASIN_STEPS
 from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
 from ..simulation.engine import Options
-from .args import UsageError, check_grid_size, load_model, parse_range, parse_sets, writable_path
+from .args import UsageError, check_grid_size, load_model, parse_range, parse_sets, robot_options, writable_path
 from .output import write_output
 
 
@@ -51,7 +51,7 @@ def sweep_cli(args: Any) -> dict[str, Any]:
     out = writable_path(args.out, (".csv", ".parquet"), "--out")
     plot = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     # the compiled model when the index holds it: no SymPy here, nor in workers it is sent to
-    system = load_model(args.model, compiled=True, derivatives=True)
+    system = load_model(args.model, compiled=True, derivatives=True, **robot_options(args))
     names = [r[0] for r in ranges]
     if basin_kind:
         known = list(system.state_names(system.mode_names[0]))

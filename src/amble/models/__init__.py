@@ -107,6 +107,8 @@ def source_files(spec: str) -> list[Path]:
     ``path.py[:callable]`` (what it reads while it runs is found by :func:`load_traced`)."""
     if is_file_spec(spec):
         return [Path(_split_spec(spec)[0]).resolve()]
+    if is_robot_file(spec):
+        return [Path(spec).resolve()]
     return sorted(f for d in __path__ for f in Path(d).resolve().glob("*.py"))
 
 
@@ -164,6 +166,43 @@ def _outside(path: str) -> Path | None:
     if "__pycache__" in p.parts or any(p.is_relative_to(d) for d in skip):
         return None
     return p
+
+
+#: suffixes of robot description files the command line takes as a model
+ROBOT_SUFFIXES = (".urdf",)
+#: suffixes of robot descriptions that are recognised but not read
+_UNREAD = {".xml": "MJCF", ".mjcf": "MJCF", ".sdf": "SDF"}
+
+
+def is_robot_file(spec: str) -> bool:
+    """Whether ``spec`` names a robot description file (``….urdf``; MJCF and SDF are recognised
+    and refused by :func:`load_robot`)."""
+    return spec.lower().endswith(ROBOT_SUFFIXES + tuple(_UNREAD))
+
+
+def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: bool = False) -> HybridSystem:
+    """The robot of a URDF file as a system of one mode: its tree with ``base`` (default: the
+    file's root link) attached to the world by a ``floating`` joint (six coordinates
+    ``base_x``, ``base_y``, ``base_z`` (m) and ``base_yaw``, ``base_pitch``, ``base_roll`` (rad),
+    zero: the base link at the world origin, upright), or fixed to it with ``fixed_base``. No
+    ground, no contact: a floating robot falls, a fixed one swings under gravity. The default start
+    is every coordinate and rate zero; links without an inertial are massless."""
+    from ..modelling.hybrid import HybridSystem
+    from ..modelling.model import Model
+    from ..modelling.tree import Joint
+
+    text = os.fspath(path)
+    kind = _UNREAD.get(Path(text).suffix.lower())
+    if kind is not None:
+        raise ModelError(f"{text}: {kind} files are not read; give the robot as a URDF file")
+    if not Path(text).is_file():
+        raise ModelError(f"robot file {text!r} does not exist")
+    model = Model.from_urdf(text, base=base, base_joint=None if fixed_base else Joint("floating"),
+                            allow_massless=True)
+    system = HybridSystem(model.name, model, doc=f"{Path(text).name}: "
+                          + ("fixed base" if fixed_base else "floating base") + f", {len(model.q)} coordinates")
+    system.default_start[model.name] = [0.0] * (2 * len(model.q))
+    return system
 
 
 def is_file_spec(spec: str) -> bool:
