@@ -92,7 +92,6 @@ def test_foot_placement_recovers_from_a_sideways_push_that_fells_the_passive_wal
     assert np.max(np.abs(states[-1] - kuo_3d.FIXED_POINT)) < 1e-6
 
 
-@pytest.mark.slow
 def test_rigid_hips_give_kuos_three_degrees_of_freedom_the_same_kind_of_gait():
     lc = find_fixed_point(kuo_3d.rigid_walker())
     assert np.sum(np.abs(lc.multipliers) > 1) == 1

@@ -32,7 +32,6 @@ def rabbit_walker():
     return walker(m, foot="right_foot", hip="torso", slope=0.0, relabel=swap, start=list(stand))
 
 
-@pytest.mark.slow
 def test_rabbit_walks_at_0_8_m_per_s_from_standing():
     g = optimize_gait(rabbit_walker(), speed=0.8, guess="stand", step_time=0.4, nodes=20)
     assert g.max_violation <= 1e-8
