@@ -70,7 +70,7 @@ def test_rabbit_hzd_gait_at_0_8_m_per_s_from_standing_still_satisfies_the_models
 def test_rabbit_hzd_coarse_gait_walks_in_closed_loop(coarse_gait):
     """The coarse gait (10 intervals) walked by the model's compiled HZD controller with the exported
     parameters: the step ends at the collocated step time and state, to the accuracy of so coarse a
-    mesh (6e-5 rad/s at the impact; the finer mesh below gets 3e-6), and Newton on the closed-loop
+    mesh (6e-5 rad/s at the impact, 3e-6 with 20 intervals), and Newton on the closed-loop
     return map finds a stable gait next to the optimised fixed point."""
     from amble import simulate
     from amble.analysis.poincare import find_fixed_point
