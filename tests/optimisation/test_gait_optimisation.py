@@ -226,8 +226,8 @@ def test_open_loop_replay_of_optimised_inputs_reproduces_the_gait():
     """A powered gait on level ground (hip and ankle, 0.8 m/s, mesh 20 → 80) replayed open loop
     with the optimised inputs as laws of time: the simulated step follows the collocated one and
     returns to the fixed point to the collocation's accuracy (an open-loop law of time has no
-    autonomous return map to refine by Newton, unlike the passive and HZD loops above). Slow:
-    the piecewise law compiles."""
+    autonomous return map to refine by Newton, unlike the passive and HZD loops above). The fine
+    mesh of the replay at 10 and 20 intervals above: its law of 80 pieces takes longer to compile."""
     g = optimize_gait(actuated_compass(), params={"slope": 0.0}, speed=0.8, nodes=[20, 80], guess="interpolate",
                       step_time=0.6)
     replay = actuated_compass()

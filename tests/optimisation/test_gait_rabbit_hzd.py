@@ -95,7 +95,7 @@ def test_rabbit_hzd_gait_walks_in_closed_loop():
     exported parameters walks the gait. The closed-loop state stays within 1e-4 of the collocated
     one, at the collocation points and along the step (the solution's Hermite interpolant);
     Newton on the closed-loop return map converges (residual ≤ 1e-8) within 1e-5 of the optimised
-    fixed point. Slow: the HZD controller of RABBIT compiles (about 40 s, once per cache)."""
+    fixed point. The fine mesh of the coarse closed-loop test above."""
     from amble import simulate
     from amble.analysis.poincare import find_fixed_point
 
