@@ -82,6 +82,44 @@ def test_urdf_robot_matches_pinocchio(name):
     _compare(name)
 
 
+def _serial_chain_urdf(path: Path, links: int, seed: int = 3) -> None:
+    """A serial chain of ``links`` bodies on revolute joints: joint axes in turn along x, y and z of
+    frames turned by non-zero roll, pitch and yaw, centres of mass off the joint axes and full
+    (non-diagonal) inertia tensors, ``R diag(a, b, c) Rᵀ`` with principal moments that satisfy the
+    triangle inequality."""
+    rng = np.random.default_rng(seed)
+    fmt = lambda v: " ".join(repr(round(float(a), 6)) for a in v)  # noqa: E731
+    parts = ['<?xml version="1.0"?>', '<robot name="chain">', '  <link name="base"/>']
+    for i in range(links):
+        R, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        inertia = R @ np.diag(rng.uniform(0.01, 0.02, 3)) @ R.T
+        (ixx, ixy, ixz), (_, iyy, iyz), (_, _, izz) = inertia.tolist()
+        parts += [f'  <link name="link{i}"><inertial>',
+                  f'    <origin xyz="{fmt(rng.uniform(-0.05, 0.05, 2).tolist() + [-0.15])}" rpy="0 0 0"/>',
+                  f'    <mass value="{round(float(rng.uniform(0.5, 2.0)), 6)!r}"/>',
+                  f'    <inertia ixx="{ixx!r}" iyy="{iyy!r}" izz="{izz!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyz="{iyz!r}"/>',
+                  '  </inertial></link>',
+                  f'  <joint name="j{i}" type="revolute">',
+                  f'    <parent link="{"base" if i == 0 else f"link{i - 1}"}"/><child link="link{i}"/>',
+                  f'    <origin xyz="{fmt([0.02, -0.01, -0.3 if i else 0.0])}"'
+                  f' rpy="{fmt(rng.uniform(-0.6, 0.6, 3))}"/>',
+                  f'    <axis xyz="{fmt(np.eye(3)[i % 3])}"/>',
+                  '    <limit lower="-3" upper="3" effort="100" velocity="10"/>',
+                  '  </joint>']
+    path.write_text("\n".join([*parts, "</robot>", ""]))
+
+
+def test_serial_chain_of_eight_links_matches_pinocchio(tmp_path):
+    """A chain as long as the legs and arms of the 30-link humanoid below are short: eight joints in
+    series, each body's M, h and q̈ through every joint before it."""
+    path = tmp_path / "chain.urdf"
+    _serial_chain_urdf(path, 8)
+    model = Model.from_urdf(path)
+    assert len(model.q) == 8
+    k = build(HybridSystem(model.name, model))
+    _check(model, k, np.zeros(1), pin.buildModelFromUrdf(str(path)), 50)
+
+
 @pytest.mark.slow
 def test_humanoid30_matches_pinocchio():
     _compare("humanoid30")

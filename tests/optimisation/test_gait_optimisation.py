@@ -186,13 +186,48 @@ def test_hzd_gait_walks_in_closed_loop_under_its_virtual_constraints():
     assert lc.residual <= 1e-8 and np.abs(lc.fixed_point - g.fixed_point).max() <= 1e-5
 
 
+def _replay_error(nodes):
+    """A powered compass gait on level ground (hip and ankle, 0.8 m/s, ``nodes`` intervals) and its
+    open-loop replay with :meth:`Gait.input_laws`: the laws at the collocation points (N·m, largest
+    difference from the optimised inputs), and how far the simulated step is from the collocated one
+    (rad, rad/s; largest over the step, and after the impact)."""
+    import sympy as sp
+
+    from amble.modelling.geometry import t as time
+
+    g = optimize_gait(actuated_compass(), params={"slope": 0.0}, speed=0.8, nodes=nodes, guess="interpolate",
+                      step_time=0.6)
+    replay = actuated_compass()
+    m = replay.modes["compass-gait"]
+    laws = g.input_laws(m)
+    at_points = np.column_stack([sp.lambdify(time, laws[u], "numpy")(g.times) for u in m.inputs])
+    m.control(laws)
+    tr = simulate(replay, g.fixed_point, params={"slope": 0.0}, steps=1, sample_dt=0.005)
+    ev = tr.step_events[0]
+    inside = tr.t < min(ev.t, g.step_time)
+    assert inside.sum() > 50  # a step of about 0.5 s, sampled every 5 ms
+    return (np.abs(at_points - g.inputs).max() / np.abs(g.inputs).max(),
+            np.abs(tr.x[inside] - g.state(tr.t[inside])).max(), np.abs(ev.x_post - g.fixed_point).max())
+
+
+def test_input_laws_replay_the_gait_with_the_collocations_fourth_order_error():
+    """The laws pass through the optimised inputs at every collocation point (to round-off), and
+    the open-loop walk under them — amble's integrator, not the collocation — follows the
+    collocated step with the error of Hermite–Simpson collocation, fourth order in the interval:
+    halving the intervals (10 → 20) divides it by about 2⁴ = 16."""
+    coarse, fine = _replay_error(10), _replay_error(20)
+    assert coarse[0] <= 1e-12 and fine[0] <= 1e-12
+    assert fine[1] <= 1e-5 and fine[2] <= 1e-5
+    assert 10 < coarse[1] / fine[1] < 25 and 10 < coarse[2] / fine[2] < 25
+
+
 @pytest.mark.slow
 def test_open_loop_replay_of_optimised_inputs_reproduces_the_gait():
     """A powered gait on level ground (hip and ankle, 0.8 m/s, mesh 20 → 80) replayed open loop
     with the optimised inputs as laws of time: the simulated step follows the collocated one and
     returns to the fixed point to the collocation's accuracy (an open-loop law of time has no
-    autonomous return map to refine by Newton, unlike the passive and HZD loops above). Slow:
-    the piecewise law compiles."""
+    autonomous return map to refine by Newton, unlike the passive and HZD loops above). The fine
+    mesh of the replay at 10 and 20 intervals above: its law of 80 pieces takes longer to compile."""
     g = optimize_gait(actuated_compass(), params={"slope": 0.0}, speed=0.8, nodes=[20, 80], guess="interpolate",
                       step_time=0.6)
     replay = actuated_compass()
