@@ -1,4 +1,5 @@
-"""The 3D humanoid against conservation laws at the impact, and its walking."""
+"""The 3D humanoid against conservation laws at the impact, its walking, and its limit cycle
+against the same robot written out independently (tests/oracles/humanoid_3d_yaw.py)."""
 
 import numpy as np
 import pytest
@@ -72,10 +73,30 @@ def test_upright_sagittal_start_is_attracted_to_the_default_gait(humanoid):
     assert np.allclose(tr.final_post_impact_state, humanoid.default_start["humanoid-3d-yaw"], atol=1e-6)
 
 
-def test_stable_limit_cycle(humanoid):
+@pytest.fixture(scope="module")
+def cycle(humanoid):
     from amble.analysis.poincare import find_fixed_point
 
-    lc = find_fixed_point(humanoid)
-    assert lc.residual < 1e-9
-    assert lc.stable and np.all(np.abs(lc.multipliers) < 1)
-    assert np.allclose(lc.fixed_point, humanoid.fixed_point_guess, atol=1e-8)
+    return find_fixed_point(humanoid)
+
+
+def test_stable_limit_cycle_is_a_fixed_point_of_the_independent_step_map(cycle):
+    """The robot's equations formed by Kane's method and its impact by the extended-coordinate
+    plastic impact, integrated by SciPy (DOP853 at 1e-12): amble's fixed point maps to itself in
+    the same time, and the map's multipliers (central differences of the 14-D map) are amble's."""
+    from oracles.humanoid_3d_yaw import jacobian, step
+
+    assert cycle.residual < 1e-9
+    assert cycle.stable and np.all(np.abs(cycle.multipliers) < 1)
+    nxt, period = step(cycle.fixed_point)
+    # amble's residual is ~1e-12; with |multipliers| ≤ 0.53 a residual r puts the fixed point
+    # within r / (1 − 0.53) of the oracle's
+    assert np.max(np.abs(nxt - cycle.fixed_point)) < 1e-9
+    assert period == pytest.approx(cycle.step_time, abs=1e-9)
+    assert abs(cycle.fixed_point).max() > 0.5  # a gait, not the rest state
+    ours = cycle.multipliers[np.abs(cycle.multipliers) > 1e-6]
+    mu = np.linalg.eigvals(jacobian(cycle.fixed_point))
+    ref = mu[np.abs(mu) > 1e-6]  # the rest are zero up to the differences' error (~1e-8)
+    assert len(ours) == len(ref) == 10
+    # the differences carry errors of ~1e-6 (the integration tolerance over a 1e-6 step)
+    np.testing.assert_allclose(np.sort_complex(ours), np.sort_complex(ref), rtol=0, atol=1e-5)
