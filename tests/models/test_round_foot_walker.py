@@ -174,6 +174,8 @@ def test_stable_limit_cycle_at_the_defaults(rfw):
     assert lc.residual < 1e-9 and lc.stable
     st, sw = lc.fixed_point[:2]
     assert st + sw == pytest.approx(2 * 0.05, abs=1e-9)  # both feet on the slope: legs symmetric about the normal
+    # the model's stored start is this gait (that the gait is the walker's is checked against an
+    # independent SciPy model below)
     np.testing.assert_allclose(lc.fixed_point, rfw.default_start["round-foot-walker"], atol=1e-9)
 
 
