@@ -64,6 +64,23 @@ def test_impact_conserves_3d_angular_momentum_and_never_adds_energy(humanoid):
         assert e1 <= e0 * (1 + 1e-12)
 
 
+def test_the_oracles_leg_swap_is_the_mirror_image():
+    """The oracle's relabelling is geometry, not a copy of the model's: after its swap every
+    point, seen from the new stance foot, is the mirror image (y → −y) of its old partner seen
+    from the old swing foot."""
+    from oracles.humanoid_3d_yaw import PARAMS, impact, points
+
+    partner = {"stance_mass": "swing_mass", "hip": "hip", "swing_mass": "stance_mass", "torso": "torso"}
+    flip = np.array([1.0, -1.0, 1.0])  # a position under y → −y
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        x = np.concatenate([rng.uniform(-0.4, 0.4, 7), rng.uniform(-2, 2, 7)])
+        old, new = points(x), points(impact(x, PARAMS))
+        for name, was in partner.items():
+            np.testing.assert_allclose(new[name], flip * (old[was] - old["swing_foot"]), atol=1e-14)
+        np.testing.assert_allclose(new["swing_foot"], -flip * old["swing_foot"], atol=1e-14)
+
+
 def test_walks_50_steps_with_bounded_sway(humanoid):
     tr = simulate(humanoid, steps=50)
     assert tr.status == "completed" and tr.steps == 50

@@ -136,6 +136,12 @@ def mass_matrix_and_bias(x: np.ndarray, p: dict) -> tuple[np.ndarray, np.ndarray
     return mm, h
 
 
+def points(x: np.ndarray, p: dict | None = None) -> dict[str, np.ndarray]:
+    """Positions (m) of the masses and the swing foot, the stance foot at the origin."""
+    pos = _terms(x, PARAMS if p is None else p)[0]
+    return dict(zip(("stance_mass", "hip", "swing_mass", "torso", "swing_foot"), pos, strict=True))
+
+
 def swing_foot(x: np.ndarray, p: dict) -> np.ndarray:
     q = x[:N]
     return np.array(_kinematics()[2](np.sin(q).tolist(), np.cos(q).tolist(), p["a"], p["b"], p["w"]))
