@@ -4,9 +4,11 @@ Their state is (θ_ns, θ_s, θ̇_ns, θ̇_s) with angles of the opposite sign t
 convention: stance, swing, stance_dot, swing_dot); so stance = −θ_s, swing = −θ_ns. The widely
 quoted fixed point at φ = 3°, g = 9.8 is (θ_ns, θ_s, θ̇_ns, θ̇_s) = (−0.3234, 0.2187, −0.3772,
 −1.0918) (four digits); the first period doubling is reported at φ = 4.37° (1998).
-See docs/references.md for the sources of every number.
+See docs/references.md for the sources of every number. To all digits: their equations written
+out and integrated by SciPy (tests/oracles/compass_gait.py).
 """
 
+import functools
 import math
 
 import numpy as np
@@ -14,6 +16,16 @@ import pytest
 
 from amble import ConvergenceError
 from amble.analysis.poincare import ReturnMap, find_fixed_point
+
+
+@functools.cache
+def goswami_oracle(slope: float) -> tuple[np.ndarray, np.ndarray]:
+    """The post-impact fixed point in our coordinates (g = 9.81) and the multipliers of
+    Goswami's walker integrated by SciPy."""
+    from oracles.compass_gait import fixed_point
+
+    x, jac = fixed_point(slope)
+    return np.array([-x[1], -x[0], -x[3], -x[2]]), np.linalg.eigvals(jac)
 
 
 def test_fixed_point_matches_goswami_at_3_degrees(compass):
@@ -42,6 +54,10 @@ def test_multipliers_are_those_of_the_step_map(compass):
     rate = (norms[-1] / norms[-5]) ** (1 / 4)
     assert abs(rate - max(abs(lc.multipliers))) < 0.02
     assert len(lc.multipliers) == 3  # 4 states minus the section constraint
+    # and to all digits against Goswami's equations integrated by SciPy (central differences, ~1e-9)
+    x_ref, mu_ref = goswami_oracle(math.radians(3.0))
+    np.testing.assert_allclose(lc.fixed_point, x_ref, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(np.sort_complex(lc.multipliers), np.sort_complex(mu_ref), rtol=0, atol=1e-7)
 
 
 def test_first_period_doubling_where_goswami_reports_it(compass):

@@ -1,4 +1,5 @@
-"""Humanoid 2D: impacts against conservation laws, the controlled gait, and the step-length torque."""
+"""Humanoid 2D: impacts against conservation laws, the controlled gait against the same robot
+written out independently (tests/oracles/humanoid_2d.py), and the step-length torque."""
 
 import numpy as np
 import pytest
@@ -75,6 +76,21 @@ def test_default_limit_cycle_is_stable(humanoid):
     assert lc.residual < 1e-9 and lc.stable
     st, sh, th = lc.fixed_point[:3]
     assert st + sh == pytest.approx(2 * 0.05, abs=1e-9) and sh == th
+    # the same robot by Kane's equations, its knee lock and heel strike, integrated by SciPy
+    # (DOP853 at 1e-12): amble's fixed point maps to itself, with amble's event times
+    from oracles.humanoid_2d import jacobian, step
+
+    nxt, t_knee, t_step = step(lc.fixed_point)
+    assert np.max(np.abs(nxt - lc.fixed_point)) < 1e-9
+    assert t_step == pytest.approx(lc.step_time, abs=1e-9)
+    knee = next(e for e in lc.trajectory(steps=1).events if e.name == "knee_lock")
+    assert t_knee == pytest.approx(knee.t, abs=1e-9)
+    # and the map's multipliers (central differences of the 6-D map; one of them is the section's 0)
+    mu = np.linalg.eigvals(jacobian(lc.fixed_point))
+    ref = mu[np.argsort(-np.abs(mu))][:len(lc.multipliers)]
+    assert len(lc.multipliers) == 5 and np.abs(mu).min() < 1e-6
+    np.testing.assert_allclose(np.sort_complex(lc.multipliers), np.sort_complex(ref), rtol=0, atol=1e-6)
+    # the model's stored start is this gait
     np.testing.assert_allclose(lc.fixed_point, humanoid.default_start["unlocked"], atol=1e-9)
 
 

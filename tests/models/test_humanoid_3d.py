@@ -1,4 +1,5 @@
-"""The thesis' 3D humanoid (knee, seven coordinates) against conservation laws, and its gait.
+"""The thesis' 3D humanoid (knee, seven coordinates) against conservation laws, and its gait against the
+2D robot written out independently (tests/oracles/humanoid_2d.py).
 
 Angular momenta are computed here from the compiled kinematics (positions and velocities of the
 named points) and the masses written out below, with numpy: they are not quantities the model or
@@ -95,6 +96,21 @@ def test_stable_limit_cycle_with_a_knee(humanoid):
     assert np.all(np.abs(lc.multipliers) < 1)
     tr = simulate(humanoid, lc.fixed_point, steps=1, sample_dt=0.0)
     assert [e.name for e in tr.events] == ["knee_lock", "heel_strike"]  # the knee locks before heel strike
+    # left–right symmetric: the gait is the 2D humanoid's with every coronal angle and rate zero,
+    # which the 2D robot written out independently and integrated by SciPy maps to itself
+    from oracles.humanoid_2d import jacobian, step
+
+    x = lc.fixed_point
+    coronal = [1, 4, 6, 8, 11, 13]
+    assert np.max(np.abs(x[coronal])) < 1e-12
+    planar = x[[0, 3, 2, 5, 7, 10, 9, 12]]  # (stance, shank, thigh, torso) and their rates
+    nxt, t_knee, t_step = step(planar)
+    assert np.max(np.abs(nxt - planar)) < 1e-9 and t_step == pytest.approx(lc.step_time, abs=1e-9)
+    assert t_knee == pytest.approx(tr.events[0].t, abs=1e-9)
+    # and the sagittal multipliers are among the 3D ones
+    mu = np.linalg.eigvals(jacobian(planar))
+    for m in mu[np.abs(mu) > 0.01]:
+        assert np.min(np.abs(lc.multipliers - m)) < 1e-6
 
 
 def test_a_sideways_lean_and_sway_die_out(humanoid):

@@ -15,10 +15,12 @@ from amble.simulation.simulate import parameter_vector
 #: (the thesis prints 0.0504), which is the slope of her published fixed point (docs/references.md, 3a).
 HSU_CHEN = dict(mh=0.5, mt=0.5, ms=0.05, a1=0.375, b1=0.125, a2=0.175, b2=0.325, g=9.8,
                 slope=float(np.arcsin(7.25 / 144)))
-#: her published fixed point [q1, q2 = q3, q1', q2' = q3'] (code's default x0), Goswami's signs: ours = −hers
 #: McGeer (1990) Fig. 2 in leg lengths, gyration radii as segment inertias m·r² (his round feet left out)
 MCGEER = dict(mh=0.6885, mt=0.1, ms=0.062, a1=0.30, b1=0.24, a2=0.26, b2=0.20, It=0.1 * 0.135**2, Is=0.062 * 0.186**2,
               slope=0.0456)
+#: the model's default parameters (segment inertias zero: point masses, as in Hsu Chen's walker)
+DEFAULTS = dict(mh=10.0, mt=3.5, ms=1.5, a1=0.25, b1=0.25, a2=0.15, b2=0.35, g=9.81, slope=0.05)
+#: her published fixed point [q1, q2 = q3, q1', q2' = q3'] (code's default x0), Goswami's signs: ours = −hers
 HSU_CHEN_X0 = np.array([0.187700106303669, -0.288437140111164, -1.101439041094875, -0.039885255927632])
 
 
@@ -112,7 +114,14 @@ def test_default_limit_cycle_is_stable(kneed):
     st, sh, th = lc.fixed_point[:3]
     # on the section: both feet on the slope (legs symmetric about its normal) and a straight swing knee
     assert st + sh == pytest.approx(2 * 0.05, abs=1e-9) and sh == th and lc.fixed_point[4] == lc.fixed_point[5]
-    np.testing.assert_allclose(lc.fixed_point, kneed.default_start["unlocked"], atol=1e-9)
+    # the same walker at the model's defaults (It = Is = 0: point masses, as hers) integrated by
+    # the SciPy oracle, from Newton started at the model's stored gait (her signs: ours = −hers)
+    x = np.asarray(kneed.default_start["unlocked"])
+    ref = _oracle(DEFAULTS["slope"], (-x[0], -x[3], -x[5]), DEFAULTS)
+    np.testing.assert_allclose(lc.fixed_point, _hers_to_ours(ref["fixed_point"]), rtol=0, atol=1e-9)
+    assert lc.step_time == pytest.approx(ref["step_time"], abs=1e-9)
+    key = lambda z: (abs(z), z.imag)  # noqa: E731
+    np.testing.assert_allclose(sorted(lc.multipliers, key=key), sorted(ref["multipliers"], key=key), atol=1e-6)
 
 
 def euler_stride(k, p, x, dt=1e-3):
@@ -149,13 +158,18 @@ def test_hsu_chen_published_fixed_point_is_that_of_her_euler_scheme(kneed):
     np.testing.assert_allclose(euler_stride(k, p, x0), x0, rtol=0, atol=1e-9)
 
 
-@functools.cache
-def _oracle(slope: float, z0: tuple = (0.1877, -1.1014, -0.0399)) -> dict:
+def _oracle(slope: float, z0: tuple = (0.1877, -1.1014, -0.0399), params: dict | None = None) -> dict:
     """Hsu Chen's walker integrated by SciPy from equations written out independently of amble
-    (tests/oracles/kneed_biped.py): her signs, post-heel-strike state [q1, q2, q3, q1', q2', q3']."""
+    (tests/oracles/kneed_biped.py), with her parameters or ``params``, on ``slope``: her signs,
+    post-heel-strike state [q1, q2, q3, q1', q2', q3']."""
+    return _oracle_cached(slope, tuple(float(v) for v in z0), tuple(sorted((params or HSU_CHEN).items())))
+
+
+@functools.cache
+def _oracle_cached(slope: float, z0: tuple, params: tuple) -> dict:
     from oracles.kneed_biped import limit_cycle
 
-    return limit_cycle(dict(HSU_CHEN, slope=slope), z0)
+    return limit_cycle(dict(dict(params), slope=slope), z0)
 
 
 def _hers_to_ours(x):

@@ -1,11 +1,12 @@
 """RABBIT under HZD: as ε → 0 the full-order multipliers converge to the restricted Poincaré map
-of the zero dynamics — computed here independently by integrating the 1-DOF zero dynamics in
-time with SciPy — and the gait is a stable, feasible period-1 walk between 0.5 and 1 m/s."""
+of the zero dynamics — computed here from the robot's full-order equations written out
+independently (tests/oracles/rabbit_zero_dynamics.py: Kane's equations, the manifold q(θ) of the
+Bézier constraints, the torso row for θ̈, the plastic impact for θ̇⁺ = δ θ̇⁻, SciPy's DOP853) —
+and the gait is a stable, feasible period-1 walk between 0.5 and 1 m/s."""
 
 import numpy as np
 import pytest
 import sympy as sp
-from scipy.integrate import solve_ivp
 
 from amble import derive
 from amble.analysis.gait_check import check_gait
@@ -20,31 +21,39 @@ def rabbit():
     return load("rabbit")
 
 
-def _restricted_scipy(system):
-    m = system.modes["rabbit"]
+def _oracle(system):
+    """The oracle's zero dynamics at the system's parameters and Bézier coefficients."""
+    from oracles.rabbit_zero_dynamics import PARAMS, ZeroDynamics
+
     p = system.parameters
-    eq = derive(m)
-    zd = zero_dynamics(m, eq.M, eq.h, eq.Gamma, eq.B)
-    f = sp.lambdify([zd.theta, zd.theta_dot], zd.theta_ddot.xreplace({s: p[str(s)] for s in m.params}), cse=True)
-    th0, th1 = p["phase_start"], p["phase_end"]
-    delta = impact_on_zero_dynamics(system).delta
+    alpha = [[p[f"alpha_{i}_{k}"] for k in range(6)] for i in range(4)]
+    return ZeroDynamics(alpha, p["phase_start"], p["phase_end"], {name: p[name] for name in PARAMS})
 
-    def P(w):
-        end = lambda t, y: y[0] - th1
-        end.terminal, end.direction = True, 1
-        sol = solve_ivp(lambda t, y: [y[1], f(y[0], y[1])], (0, 5), [th0, w], events=end, rtol=1e-12, atol=1e-12)
-        return delta * sol.y_events[0][0][1], sol.t_events[0][0]
 
-    w = 1.0
-    for _ in range(80):
-        w = P(w)[0]
-    h = 1e-5
-    return w, (P(w + h)[0] - P(w - h)[0]) / (2 * h), P(w)[1]
+def _restricted_scipy(system):
+    lc = _oracle(system).limit_cycle(guess=1.0)
+    assert lc["residual"] < 1e-12
+    return lc["theta_dot"], lc["multiplier"], lc["step_time"]
 
 
 @pytest.fixture(scope="module")
 def restricted(rabbit):
     return _restricted_scipy(rabbit)
+
+
+def test_amble_zero_dynamics_agree_with_the_oracle(rabbit):
+    """amble's symbolic zero dynamics (derivation/hzd.py) and impact on Z (analysis/hzd.py) against
+    the oracle's numerical ones, at states across the step."""
+    m = rabbit.modes["rabbit"]
+    p = rabbit.parameters
+    eq = derive(m)
+    zd = zero_dynamics(m, eq.M, eq.h, eq.Gamma, eq.B)
+    f = sp.lambdify([zd.theta, zd.theta_dot], zd.theta_ddot.xreplace({s: p[str(s)] for s in m.params}), cse=True)
+    oracle = _oracle(rabbit)
+    for theta in np.linspace(p["phase_start"], p["phase_end"], 7):
+        for theta_dot in (0.5, 0.9, 1.4):
+            assert float(f(theta, theta_dot)) == pytest.approx(oracle.theta_ddot(theta, theta_dot), abs=1e-10)
+    assert impact_on_zero_dynamics(rabbit).delta == pytest.approx(oracle.impact_ratio(), abs=1e-12)
 
 
 def test_the_gait_multiplier_is_the_restricted_one(rabbit, restricted):
@@ -58,6 +67,10 @@ def test_the_gait_multiplier_is_the_restricted_one(rabbit, restricted):
     assert lc.step_time == pytest.approx(T, abs=1e-6)
     x = lc.fixed_point  # θ̇⁺ = torso_dot + stance_hip_dot + stance_knee_dot/2 is the restricted fixed point
     assert x[5] + x[6] + x[8] / 2 == pytest.approx(w, abs=1e-7)
+    # and the full state is the oracle's point of Z: q = q(θ⁺), q̇ = q_θ θ̇⁺
+    q, q_theta, _ = _oracle(rabbit).q_of(rabbit.parameters["phase_start"])
+    np.testing.assert_allclose(x[:5], q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(x[5:], q_theta * w, rtol=0, atol=1e-7)
 
 
 def test_multipliers_converge_to_the_restricted_map(rabbit, restricted):

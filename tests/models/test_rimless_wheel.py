@@ -68,6 +68,17 @@ def test_default_fixed_point_search(system):
     lc = find_fixed_point(system)
     assert lc.fixed_point[1] == pytest.approx(omega_star(DEFAULTS), abs=1e-8)
     assert lc.step_time == pytest.approx(1.0345498, abs=1e-6)  # docs/references.md §4 [R]
+    assert lc.step_time == pytest.approx(step_time(DEFAULTS), abs=1e-9)
+
+
+def step_time(p: dict[str, float]) -> float:
+    """Time (s) from θ = γ − α to γ + α on the rolling cycle, by quadrature of the energy integral
+    θ̇² = ω*² + 2 (g/l)(cos(γ − α) − cos θ) of θ̈ = (g/l) sin θ."""
+    from scipy.integrate import quad
+
+    a, gam, w = p["alpha"], p["slope"], omega_star(p)
+    speed = lambda th: math.sqrt(w**2 + 2 * p["g"] / p["l"] * (math.cos(gam - a) - math.cos(th)))  # noqa: E731
+    return quad(lambda th: 1 / speed(th), gam - a, gam + a, epsabs=1e-12, epsrel=1e-12)[0]
 
 
 def test_derived_impact_keeps_angular_momentum_about_the_new_foot(system):

@@ -8,10 +8,12 @@ Reference values (see docs/references.md, section 2, for provenance):
   θ̇* = −0.20386692731962, eigenvalues 4.000 and 0.459.
 * Bhounsule's ``simplestwalker.m`` (2013): the full long-period state
   [0.200310900563820, −0.199832473025474, 0.400621801127640, −0.015822999949030], t = 3.882.
-* An independent recomputation (scipy DOP853, rtol = atol = 1e-13, central differences):
-  eigenvalues −0.19009984 ± 0.55759878i, step period 3.882464. Garcia's printed eigenvalues
-  differ from it by about 1e-3, more than the difference between the published fixed points,
-  so they are checked to that looser tolerance only.
+* Garcia's equations and heel-strike map written out by hand and integrated by SciPy
+  (tests/oracles/simplest_walker.py: DOP853 at rtol = atol = 1e-13, the map's Jacobian from the
+  variational equations and the saltation matrix), computed here: long period θ* = 0.2003109005,
+  eigenvalues −0.19009984 ± 0.55759878i, step period 3.882464; short period eigenvalues 4.00386
+  and 0.45959. Garcia's printed eigenvalues differ from it by about 1e-3, more than the difference
+  between the published fixed points, so they are checked to that looser tolerance only.
 * Garcia et al. 1998, App. A.2 / Fig. 3 caption: small-slope expansion of the long-period
   gait, θ* ≈ Θ₀ γ^(1/3), θ̇* ≈ α Θ₀ γ^(1/3), period → τ₀, with τ₀ = 3.812092, Θ₀ = 0.970956,
   α = −1.045203. τ₀ is the root of the linearised closing condition
@@ -37,14 +39,26 @@ GARCIA_LONG_EIG = complex(-0.19120868949940, 0.55633363687106)
 GARCIA_SHORT = (0.19393736960624, -0.20386692731962)
 GARCIA_SHORT_EIG = (4.000, 0.459)
 BHOUNSULE_LONG = (0.200310900563820, 0.400621801127640, -0.199832473025474, -0.015822999949030)
-RECOMPUTED_EIG = complex(-0.19009984, 0.55759878)
-RECOMPUTED_PERIOD = 3.882464
 TAU0, THETA0, ALPHA = 3.812092, 0.970956, -1.045203
 
 
 @pytest.fixture(scope="module")
 def system():
     return load("simplest-walker")
+
+
+@pytest.fixture(scope="module")
+def oracle_long() -> dict:
+    from oracles.simplest_walker import LONG_GUESS, limit_cycle
+
+    return limit_cycle(GAMMA, LONG_GUESS)
+
+
+@pytest.fixture(scope="module")
+def oracle_short() -> dict:
+    from oracles.simplest_walker import SHORT_GUESS, limit_cycle
+
+    return limit_cycle(GAMMA, SHORT_GUESS)
 
 
 @pytest.fixture(scope="module")
@@ -56,8 +70,10 @@ def _section_state(theta: float, theta_dot: float) -> list[float]:
     return [theta, 2 * theta, theta_dot, (1 - math.cos(2 * theta)) * theta_dot]
 
 
-def test_long_period_fixed_point_matches_garcia(cycle):
+def test_long_period_fixed_point_matches_garcia(cycle, oracle_long):
     th, ph, thd, phd = cycle.fixed_point
+    assert oracle_long["residual"] < 1e-13
+    np.testing.assert_allclose(cycle.fixed_point, oracle_long["fixed_point"], rtol=0, atol=1e-10)
     assert cycle.state_names == ["theta", "phi", "theta_dot", "phi_dot"]
     assert th == pytest.approx(GARCIA_LONG[0], abs=1e-9)
     assert thd == pytest.approx(GARCIA_LONG[1], abs=1e-9)
@@ -67,25 +83,30 @@ def test_long_period_fixed_point_matches_garcia(cycle):
     assert phd == pytest.approx((1 - math.cos(2 * th)) * thd, abs=1e-12)
 
 
-def test_long_period_step_time(cycle):
+def test_long_period_step_time(cycle, oracle_long):
     assert cycle.step_time == pytest.approx(3.882, abs=5e-4)  # Bhounsule, 3 decimals
-    assert cycle.step_time == pytest.approx(RECOMPUTED_PERIOD, abs=2e-6)
+    assert cycle.step_time == pytest.approx(oracle_long["step_time"], abs=1e-9)
 
 
-def test_long_period_multipliers(cycle):
+def test_long_period_multipliers(cycle, oracle_long):
     assert cycle.stable
     assert len(cycle.multipliers) == 2  # the heel strike forgets phi and phi_dot
     lam = cycle.multipliers[np.argmax(cycle.multipliers.imag)]
-    assert abs(lam - RECOMPUTED_EIG) < 1e-8  # all eight published digits (exact Jacobian)
+    ref = oracle_long["multipliers"][np.argmax(oracle_long["multipliers"].imag)]
+    assert abs(lam - ref) < 1e-8  # both Jacobians are exact up to the integration tolerance
     assert abs(lam - GARCIA_LONG_EIG) < 2e-3
 
 
-def test_short_period_gait_is_unstable(system):
+def test_short_period_gait_is_unstable(system, oracle_short):
     lc = find_fixed_point(system, _section_state(*GARCIA_SHORT))
     assert lc.fixed_point[0] == pytest.approx(GARCIA_SHORT[0], abs=1e-9)
     assert lc.fixed_point[2] == pytest.approx(GARCIA_SHORT[1], abs=1e-9)
+    np.testing.assert_allclose(lc.fixed_point, oracle_short["fixed_point"], rtol=0, atol=1e-10)
+    assert lc.step_time == pytest.approx(oracle_short["step_time"], abs=1e-9)
     assert not lc.stable
     np.testing.assert_allclose(sorted(abs(lc.multipliers), reverse=True), GARCIA_SHORT_EIG, atol=5e-3)
+    np.testing.assert_allclose(sorted(lc.multipliers.real, reverse=True),
+                               sorted(oracle_short["multipliers"].real, reverse=True), rtol=0, atol=1e-7)
 
 
 def test_walks_fifty_steps_from_default_start(system):
