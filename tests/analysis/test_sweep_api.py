@@ -127,5 +127,9 @@ def test_period_doubling_is_located_on_the_branch_where_the_oracle_puts_it(compa
 
 def test_period_doubling_refuses_a_result_without_a_branch(compass):
     res = sweep(compass, "fixed-point", {"slope": [0.04], "mh": [10.0]}, **SYNC)
-    with pytest.raises(StateError, match="period_doubling reads"):
+    with pytest.raises(StateError, match="not 'fixed-point-map'"):
         period_doubling(res)
+    xs = amble.find_fixed_point(compass).fixed_point
+    cells = sweep(compass, "basin", {"stance": [xs[0]], "stance_dot": [xs[2]]}, steps=5, **SYNC)
+    with pytest.raises(StateError, match="not 'BasinResult'"):
+        period_doubling(cells)

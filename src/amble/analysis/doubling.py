@@ -97,9 +97,10 @@ def period_doubling(result: SweepResult, system: HybridSystem | None = None, *,
     - a bifurcation diagram: the first value whose attractor repeats with a period ≥ 2 (no
       multipliers are stored: the grid value where the diagram shows the doubling).
     """
-    reader = _READERS.get(result.kind)
+    kind = getattr(result, "kind", type(result).__name__)  # a basin's result has no kind: it is refused too
+    reader = _READERS.get(kind)
     if reader is None:
-        raise StateError(f"period_doubling reads a result of kind {', '.join(_READERS)}, not {result.kind!r}")
+        raise StateError(f"period_doubling reads a result of kind {', '.join(_READERS)}, not {kind!r}")
     return reader(result, system, params)
 
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..backend.kernels import build
 from ..simulation.simulate import parameter_vector
+from .defaults import FIXED_POINT_TOL
 from .runner import check_params, execute, open_client
 from .store import ResultStore, SweepResult, fmt_value, state_from_row
 
@@ -44,8 +45,8 @@ class RunOptions:
     workers: int | None = None
     progress: bool = True
     max_points: int | None = None
-    rtol: float = 1e-12
-    atol: float = 1e-12
+    rtol: float = FIXED_POINT_TOL
+    atol: float = FIXED_POINT_TOL
 
 
 def deprecated(old: str, new: str, stacklevel: int = 3) -> None:
