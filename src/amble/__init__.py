@@ -40,7 +40,11 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("ReturnMap", "find_fixed_point"), ".analysis.poincare"),
     "Section": ".analysis.section",
     "linearize": ".analysis.linearize",
-    **dict.fromkeys(("period_doubling", "sweep_fixed_points", "sweep_fixed_points_2d"), ".analysis.fixed_points"),
+    # sweeps: one entry point with a kind, and one period-doubling detector; the old names are
+    # deprecated aliases (each warns, naming its replacement)
+    "sweep": ".analysis.sweep",
+    "period_doubling": ".analysis.doubling",
+    **dict.fromkeys(("sweep_fixed_points", "sweep_fixed_points_2d"), ".analysis.fixed_points"),
     **dict.fromkeys(("bifurcation", "poincare_iterates"), ".analysis.bifurcation"),
     **dict.fromkeys(("cascade", "continue_branch", "switch_at_flip"), ".analysis.continuation"),
     "basin": ".analysis.basin",

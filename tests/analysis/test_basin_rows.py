@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 from cells import walk_cell
 
-from amble.analysis.basin import BASIN_LABELS, basin
+from amble import sweep
+from amble.analysis.basin import BASIN_LABELS
 from amble.analysis.cells import TextRows, fmt_floats, fmt_ints, fmt_value
 from amble.analysis.defaults import BASIN_TOL
 from amble.analysis.poincare import find_fixed_point
@@ -89,8 +90,8 @@ def test_basin_cells_written_are_direct_walks(compass, walker, tmp_path):
     steps, every, tol = 20, 5, 1e-6
     out = tmp_path / "basin.csv"
     av, bv = np.linspace(xs[0] - 0.18, xs[0] + 0.18, 7), np.linspace(xs[2] - 0.3, xs[2] + 0.3, 5)  # x* a node
-    res = basin(compass, ("stance", "stance_dot"), ((av[0], av[-1]), (bv[0], bv[-1])), (7, 5), to_state=_on_slope,
-                steps=steps, check_every=every, tol=tol, rows_per_task=3, threads=2, out=out, **SYNC)
+    res = sweep(compass, "basin", {"stance": av, "stance_dot": bv}, to_state=_on_slope, steps=steps,
+                check_every=every, tol=tol, rows_per_task=3, threads=2, out=out, **SYNC)
     with open(out, newline="") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 35
@@ -116,19 +117,20 @@ def test_basin_cells_written_are_direct_walks(compass, walker, tmp_path):
 
 def test_resumed_basin_on_two_threads_equals_uninterrupted_one(compass, walker, tmp_path):
     _, _, xs = walker
-    grid = (("stance", "stance_dot"), ((xs[0] - 0.12, xs[0] + 0.08), (xs[2] - 0.4, xs[2] + 0.3)), (7, 6))
+    grid = {"stance": np.linspace(xs[0] - 0.12, xs[0] + 0.08, 7),
+            "stance_dot": np.linspace(xs[2] - 0.4, xs[2] + 0.3, 6)}
     kw = dict(steps=30, rows_per_task=2, **SYNC)
     ref = tmp_path / "ref.csv"
-    full = basin(compass, *grid, out=ref, **kw)
+    full = sweep(compass, "basin", grid, out=ref, **kw)
     assert full.computed == 42 and len(set(full.outcome.ravel().tolist())) >= 2
     part = tmp_path / "part.csv"
-    first = basin(compass, *grid, out=part, max_points=18, threads=2, **kw)
+    first = sweep(compass, "basin", grid, out=part, max_points=18, threads=2, **kw)
     assert first.computed == 18 and int(np.sum(first.outcome >= 0)) == 18
     with open(part, newline="") as f:
         assert sum(1 for _ in f) == 1 + 18  # durable rows (in the journal) as soon as tasks end
     with open(part, "a") as f:  # a write torn by a kill: a partial last line without newline
         f.write("3,0,-0.3,0.9,conv")
-    second = basin(compass, *grid, out=part, threads=2, **kw)
+    second = sweep(compass, "basin", grid, out=part, threads=2, **kw)
     assert second.computed == 42 - 18
     assert part.read_bytes() == ref.read_bytes()
     for name in ("outcome", "steps", "distance", "reasons"):
@@ -148,11 +150,11 @@ def test_rows_of_finished_tasks_stay_when_a_later_task_fails(compass, tmp_path, 
         return _on_slope(a, b, base)
 
     out = tmp_path / "basin.csv"
-    args = (("stance", "stance_dot"), ((-0.3, -0.1), (0.9, 1.3)), (5, 4))
+    grid = {"stance": np.linspace(-0.3, -0.1, 5), "stance_dot": np.linspace(0.9, 1.3, 4)}
     with pytest.raises(OutputError, match="later rows"):
-        basin(compass, *args, to_state=to_state, steps=10, rows_per_task=1, out=out, threads=threads, **SYNC)
+        sweep(compass, "basin", grid, to_state=to_state, steps=10, rows_per_task=1, out=out, threads=threads, **SYNC)
     with open(out, newline="") as f:
         done = sorted((int(r["i"]), int(r["j"])) for r in csv.DictReader(f))
     assert done == [(i, j) for i in range(2) for j in range(4)]  # stance −0.3 and −0.25: rows 0 and 1
-    again = basin(compass, *args, to_state=_on_slope, steps=10, rows_per_task=1, out=out, **SYNC)
+    again = sweep(compass, "basin", grid, to_state=_on_slope, steps=10, rows_per_task=1, out=out, **SYNC)
     assert again.computed == 12  # the finished rows are not walked again

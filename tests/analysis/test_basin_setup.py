@@ -15,8 +15,9 @@ from cells import walk_cell
 from scipy.optimize import root
 
 import amble.analysis.poincare as poincare
+from amble import sweep
 from amble.analysis import basin_setup
-from amble.analysis.basin import BASIN_LABELS, basin
+from amble.analysis.basin import BASIN_LABELS
 from amble.analysis.defaults import BASIN_TOL, FIXED_POINT_TOL
 from amble.backend.kernels import build
 from amble.models import load
@@ -48,8 +49,13 @@ def _scipy_fixed_point(system, slope: float, guess: np.ndarray) -> np.ndarray:
     return state(sol.x)
 
 
+def _grid(a: tuple[float, float], b: tuple[float, float], n: tuple[int, int]) -> dict[str, np.ndarray]:
+    """The ``AXES`` grid of ``n[0]`` × ``n[1]`` evenly spaced values over the boxes ``a``, ``b``."""
+    return {AXES[0]: np.linspace(*a, n[0]), AXES[1]: np.linspace(*b, n[1])}
+
+
 def _tiny(system, **kw):
-    return basin(system, AXES, ((-0.30, -0.15), (0.9, 1.2)), (2, 2), steps=5, **SYNC, **kw)
+    return sweep(system, "basin", _grid((-0.30, -0.15), (0.9, 1.2), (2, 2)), steps=5, **SYNC, **kw)
 
 
 @pytest.fixture
@@ -83,7 +89,7 @@ def test_set_up_reused_only_for_the_same_system_and_parameters(searches):
     first = _tiny(system)
     assert searches[0] == 1
     first.fixed_point[:] = 0.0  # the caller's copy: the memo is not changed through it
-    again = basin(system, AXES, ((-0.32, -0.12), (0.8, 1.3)), (3, 2), steps=5, **SYNC)  # another box
+    again = sweep(system, "basin", _grid((-0.32, -0.12), (0.8, 1.3), (3, 2)), steps=5, **SYNC)  # another box
     assert searches[0] == 1
     np.testing.assert_array_equal(again.fixed_point, _tiny(system).fixed_point)
     assert np.all(again.fixed_point != 0.0)
@@ -120,7 +126,7 @@ def test_cells_on_the_section_are_direct_walks(compass, threads):
     of the fixed point and both feet on the slope (the compass gait's post-impact section)."""
     steps, every, tol, slope = 20, 5, 1e-6, 0.05
     av, bv = np.linspace(-0.35, -0.10, 12), np.linspace(0.8, 1.4, 5)
-    res = basin(compass, AXES, ((av[0], av[-1]), (bv[0], bv[-1])), (12, 5), steps=steps, check_every=every, tol=tol,
+    res = sweep(compass, "basin", dict(zip(AXES, (av, bv))), steps=steps, check_every=every, tol=tol,
                 rows_per_task=5, threads=threads, **SYNC)
     k = build(compass)
     p = np.array(k.meta["param_defaults"], float)
@@ -141,11 +147,11 @@ def test_cells_on_the_section_are_direct_walks(compass, threads):
 
 
 def test_tasks_cut_for_threads_give_the_same_map_and_file(compass, tmp_path):
-    grid = (AXES, ((-0.35, -0.10), (0.8, 1.4)), (13, 4))
-    one = basin(compass, *grid, steps=20, out=tmp_path / "one.csv", **SYNC)
+    grid = _grid((-0.35, -0.10), (0.8, 1.4), (13, 4))
+    one = sweep(compass, "basin", grid, steps=20, out=tmp_path / "one.csv", **SYNC)
     for threads, rpt in ((2, 5), (2, 1), (3, 4)):
         path = tmp_path / f"t{threads}-{rpt}.csv"
-        many = basin(compass, *grid, steps=20, threads=threads, rows_per_task=rpt, out=path, **SYNC)
+        many = sweep(compass, "basin", grid, steps=20, threads=threads, rows_per_task=rpt, out=path, **SYNC)
         for name in ("outcome", "steps", "distance", "reasons"):
             np.testing.assert_array_equal(getattr(many, name), getattr(one, name))
         assert path.read_bytes() == (tmp_path / "one.csv").read_bytes()

@@ -62,16 +62,16 @@ def test_a_sweep_started_inside_a_task_gets_its_own_pool():
 def test_two_basins_at_once_share_the_pool_and_equal_one_at_a_time(compass):
     import numpy as np
 
-    from amble.analysis.basin import basin
+    from amble import sweep
 
     kw = dict(steps=15, rows_per_task=1, threads=2, scheduler="synchronous", progress=False)
-    grids = [(("stance", "stance_dot"), ((-0.35, -0.10), (0.8, 1.4)), (6, 3)),
-             (("stance", "stance_dot"), ((-0.30, -0.15), (0.9, 1.2)), (5, 4))]
-    alone = [basin(compass, *g, **kw) for g in grids]
+    grids = [{"stance": np.linspace(-0.35, -0.10, 6), "stance_dot": np.linspace(0.8, 1.4, 3)},
+             {"stance": np.linspace(-0.30, -0.15, 5), "stance_dot": np.linspace(0.9, 1.2, 4)}]
+    alone = [sweep(compass, "basin", g, **kw) for g in grids]
     together: list = [None, None]
 
     def one(i: int) -> None:
-        together[i] = basin(compass, *grids[i], **kw)
+        together[i] = sweep(compass, "basin", grids[i], **kw)
 
     workers = [threading.Thread(target=one, args=(i,)) for i in range(2)]
     for w in workers:

@@ -12,14 +12,11 @@ import time
 import pytest
 
 import amble.cli.sweep as cli_sweep
-from amble import OutputError, SchedulerError
-from amble.analysis.basin import basin
-from amble.analysis.bifurcation import bifurcation
-from amble.analysis.continuation_sweep import sweep_continuation
+from amble import OutputError, SchedulerError, sweep
 from amble.analysis.defaults import BASIN_STEPS, BASIN_TOL, BIFURCATION_TOL, FIXED_POINT_TOL
-from amble.analysis.fixed_points import sweep_fixed_points, sweep_fixed_points_2d
 from amble.analysis.poincare import find_fixed_point
 from amble.analysis.store import SweepResult
+from amble.analysis.sweep import KINDS
 from amble.cli.args import writable_path
 from amble.cli.main import main
 
@@ -30,17 +27,17 @@ class _Stop(Exception):
     pass
 
 
-def _capture(monkeypatch, name):
-    """Replace the API function ``name`` used by the CLI by one recording its keyword arguments."""
+def _capture(monkeypatch):
+    """Replace the sweep entry point used by the CLI by one recording its kind and keyword arguments."""
     seen: dict = {}
 
-    def fake(*args, **kw):
-        seen.update(kw)
-        if name == "basin":
+    def fake(system, kind, over, **kw):
+        seen.update(kw, kind=kind, over=dict(over))
+        if kind == "basin":
             raise _Stop
-        return SweepResult(kind="fake", params=["slope"], rows=[], path=None, complete=True, computed=0, reused=0)
+        return SweepResult(kind=kind, params=list(over), rows=[], path=None, complete=True, computed=0, reused=0)
 
-    monkeypatch.setattr(cli_sweep, name, fake)
+    monkeypatch.setattr(cli_sweep, "sweep", fake)
     return seen
 
 
@@ -49,26 +46,27 @@ def _default(fn, name):
 
 
 def test_api_defaults_come_from_one_place():
-    for fn in (sweep_fixed_points, sweep_fixed_points_2d, find_fixed_point):
-        assert _default(fn, "rtol") == _default(fn, "atol") == FIXED_POINT_TOL
-    assert _default(bifurcation, "rtol") == _default(bifurcation, "atol") == BIFURCATION_TOL
-    assert _default(basin, "rtol") == _default(basin, "atol") == BASIN_TOL
-    assert _default(basin, "steps") == BASIN_STEPS
-    assert _default(sweep_continuation, "rtol") == _default(sweep_continuation, "atol") == FIXED_POINT_TOL
+    assert _default(find_fixed_point, "rtol") == _default(find_fixed_point, "atol") == FIXED_POINT_TOL
+    assert KINDS["fixed-point"].tol == KINDS["continuation"].tol == FIXED_POINT_TOL
+    assert KINDS["bifurcation"].tol == BIFURCATION_TOL
+    assert KINDS["basin"].tol == BASIN_TOL
+    assert KINDS["basin"].options()["steps"] == BASIN_STEPS
+    assert _default(sweep, "rtol") is None and _default(sweep, "atol") is None  # → the kind's
 
 
-@pytest.mark.parametrize("kind, grid, fn", [
-    ("fixed-point", ["--param", "slope=0.04:0.05:2"], "sweep_fixed_points"),
-    ("fixed-point", ["--param", "slope=0.04:0.05:2", "--param", "mh=9:10:2"], "sweep_fixed_points_2d"),
-    ("bifurcation", ["--param", "slope=0.04:0.05:2"], "bifurcation"),
-    ("continuation", ["--param", "slope=0.04:0.05"], "sweep_continuation"),
-    ("basin", ["--x", "stance=-0.3:-0.2:2", "--x", "stance_dot=1:1.2:2"], "basin"),
+@pytest.mark.parametrize("kind, grid, n", [
+    ("fixed-point", ["--param", "slope=0.04:0.05:2"], 1),
+    ("fixed-point", ["--param", "slope=0.04:0.05:2", "--param", "mh=9:10:2"], 2),
+    ("bifurcation", ["--param", "slope=0.04:0.05:2"], 1),
+    ("continuation", ["--param", "slope=0.04:0.05"], 1),
+    ("basin", ["--x", "stance=-0.3:-0.2:2", "--x", "stance_dot=1:1.2:2"], 2),
 ])
-def test_given_tolerance_is_used_and_absent_one_is_the_api_default(monkeypatch, kind, grid, fn):
-    seen = _capture(monkeypatch, fn)
+def test_given_tolerance_is_used_and_absent_one_is_the_api_default(monkeypatch, kind, grid, n):
+    seen = _capture(monkeypatch)
     argv = ["sweep", "compass-gait", "--kind", kind, *grid, "--scheduler", "synchronous", "--json"]
     assert main([*argv, "--rtol", "1e-9", "--atol", "1e-7"]) in (0, 1)
     assert seen["rtol"] == 1e-9 and seen["atol"] == 1e-7
+    assert seen["kind"] == kind and len(seen["over"]) == n  # one entry point, the kind as given
     seen.clear()
     assert main(argv) in (0, 1)
     assert "rtol" not in seen and "atol" not in seen  # → the API's default of that kind
@@ -127,7 +125,7 @@ def test_refused_scheduler_exits_2_at_once(capsys):
 
 
 def test_records_and_table_give_numbers(compass):
-    res = sweep_fixed_points(compass, "slope", [0.04, 0.05], **SYNC)
+    res = sweep(compass, "fixed-point", {"slope": [0.04, 0.05]}, **SYNC)
     assert all(isinstance(v, str) for v in res.rows[0].values())  # the stored text is unchanged
     rec = res.records()[0]
     assert isinstance(rec["i"], int) and isinstance(rec["slope"], float) and rec["slope"] == 0.04
@@ -135,7 +133,7 @@ def test_records_and_table_give_numbers(compass):
     assert isinstance(rec["multipliers"], list) and rec["reason"] == ""
     tab = res.table()
     assert tab["i"].tolist() == [0, 1] and tab["slope"].dtype == float and tab["stable"].dtype == bool
-    bif = bifurcation(compass, "slope", [0.05], transient=20, keep=4, **SYNC).records()[0]
+    bif = sweep(compass, "bifurcation", {"slope": [0.05]}, transient=20, keep=4, **SYNC).records()[0]
     assert isinstance(bif["period"], int) and len(bif["iterates"]) == 4
     failed = SweepResult(kind="x", params=[], rows=[{"period": "", "d": ""}], path=None, complete=True, computed=0,
                          reused=0, types={"period": "int", "d": "float"})

@@ -1,4 +1,5 @@
-"""Basins of attraction: which initial post-impact states of a grid walk into the period-1 gait.
+"""Basins of attraction (the ``basin`` kind of :func:`amble.sweep`): which initial post-impact
+states of a grid walk into the period-1 gait.
 
 Each cell of a grid over two coordinates of the post-impact state is walked with the compiled
 run loop (no recording) for a bounded number of footfalls and classified as ``converged``
@@ -29,7 +30,7 @@ from .cells import TextRows, fmt_floats, fmt_ints
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
 from .section import Section
-from .sweep_runner import compiled, run_sweep
+from .sweep_runner import RunOptions, compiled, deprecated, run_sweep
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -192,64 +193,46 @@ def _arrays(rows: list[dict[str, str]], shape: tuple[int, int]) -> tuple[np.ndar
     return outcome, st, dist, why
 
 
-def basin(
-    system: HybridSystem,
-    x_names: tuple[str, str],
-    ranges: tuple[tuple[float, float], tuple[float, float]],
-    n: tuple[int, int] = (100, 100),
-    *,
-    params: Mapping[str, float] | None = None,
-    base_state: Sequence[float] | None = None,
-    to_state: Callable[[float, float, np.ndarray], np.ndarray] | None = None,
-    steps: int = BASIN_STEPS,
-    check_every: int = 5,
-    tol: float = 1e-4,
-    rows_per_task: int = 5,
-    out: str | os.PathLike | None = None,
-    scheduler: Any = None,
-    workers: int | None = None,
-    progress: bool = True,
-    max_points: int | None = None,
-    rtol: float = BASIN_TOL,
-    atol: float = BASIN_TOL,
-    threads: int = 1,
-) -> BasinResult:
-    """Basin of attraction of the period-1 gait over two post-impact coordinates.
+def basin_kind(system: HybridSystem, over: Mapping[str, np.ndarray], params: Mapping[str, float] | None,
+               run: RunOptions, *, base_state: Sequence[float] | None = None,
+               to_state: Callable[[float, float, np.ndarray], np.ndarray] | None = None, steps: int = BASIN_STEPS,
+               check_every: int = 5, tol: float = 1e-4, rows_per_task: int = 5, threads: int = 1) -> BasinResult:
+    """The ``basin`` kind of :func:`amble.sweep`: the basin of attraction of the period-1 gait over
+    two post-impact coordinates, ``over = {name_a: values_a, name_b: values_b}``.
 
-    The grid is ``n[0]`` values of ``x_names[0]`` over ``ranges[0]`` × ``n[1]`` values of
-    ``x_names[1]`` over ``ranges[1]``; the other section coordinates come from ``base_state``
-    (default: the fixed point at ``params``) and the dependent coordinates from the section
-    (:meth:`amble.analysis.section.Section.project`: the cell's state lies on the post-impact
-    section of the step transition, whatever the model). The two coordinates must chart the
-    section together (:class:`StateError` otherwise: e.g. the two angles of a compass gait, tied by
-    both feet on the slope). A cell with no section state near the gait is ``failed`` with reason
-    ``off the section``. ``to_state(a, b, base) → full state`` overrides the embedding. Each
-    cell walks up to ``steps`` footfalls (checked every ``check_every``) and is ``converged`` if
-    ``|x − x*|∞ < tol``, ``fell`` if a terminal/fall event ended it, ``not converged`` if it kept
-    walking elsewhere (another attractor or too slow), ``failed`` for any other run status.
-    One Dask task per ``rows_per_task`` grid rows. ``rtol``/``atol``: integrator tolerances
+    The grid is ``values_a`` × ``values_b`` (row ``i``, column ``j``); the other section coordinates
+    come from ``base_state`` (default: the fixed point at ``params``) and the dependent coordinates
+    from the section (:meth:`amble.analysis.section.Section.project`: the cell's state lies on the
+    post-impact section of the step transition, whatever the model). The two coordinates must chart
+    the section together (:class:`StateError` otherwise: e.g. the two angles of a compass gait, tied
+    by both feet on the slope). A cell with no section state near the gait is ``failed`` with reason
+    ``off the section``. ``to_state(a, b, base) → full state`` overrides the embedding. Each cell
+    walks up to ``steps`` footfalls (checked every ``check_every``) and is ``converged`` if
+    ``|x − x*|∞ < tol`` (default 1e-4), ``fell`` if a terminal/fall event ended it, ``not converged`` if it
+    kept walking elsewhere (another attractor or too slow), ``failed`` for any other run status. One
+    Dask task per ``rows_per_task`` grid rows (default 5). ``rtol``/``atol``: integrator tolerances
     (looser than for fixed points: only the outcome category matters here). ``threads``: with
-    ``scheduler='synchronous'``, this many tasks run side by side on threads of this process
-    (one task's Python work overlaps the others' compiled walks, which release the GIL), or, for a
-    grid of one task, its walks share them; on Dask, each task's walks share this many threads of
-    its worker. Two threads on two cores walk a map in about half the time; the result does not
-    depend on it (each cell is walked whole by one thread; the compacted file is sorted by key).
-    The fixed point and the section are found once per system and parameters in a process
+    ``scheduler='synchronous'``, this many tasks run side by side on threads of this process (one
+    task's Python work overlaps the others' compiled walks, which release the GIL), or, for a grid
+    of one task, its walks share them; on Dask, each task's walks share this many threads of its
+    worker. Two threads on two cores walk a map in about half the time; the result does not depend
+    on it (each cell is walked whole by one thread; the compacted file is sorted by key). The fixed
+    point and the section are found once per system and parameters in a process
     (:mod:`amble.analysis.basin_setup`): another map of the same gait starts walking at once.
     """
     k, pvec, snames = compiled(system, params)
+    x_names = tuple(over)
     for nm in x_names:
         if nm not in snames:
             raise StateError(f"unknown coordinate {nm!r}; known: {', '.join(snames)}")
-    if len(set(x_names)) != 2:
+    if len(x_names) != 2:
         raise StateError(f"basin: two different coordinates are needed, got {', '.join(x_names)}")
     if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
         raise StateError(f"threads must be an integer ≥ 1, got {threads!r}")
-    if len(n) != 2 or min(n) < 1 or steps < 1 or check_every < 1 or rows_per_task < 1:
-        raise StateError("need n = (na ≥ 1, nb ≥ 1), steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
-    av = np.linspace(ranges[0][0], ranges[0][1], int(n[0]))
-    bv = np.linspace(ranges[1][0], ranges[1][1], int(n[1]))
-    sweep_values(av, x_names[0]), sweep_values(bv, x_names[1])
+    if steps < 1 or check_every < 1 or rows_per_task < 1:
+        raise StateError("need steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
+    av, bv = (np.asarray(over[nm], float) for nm in x_names)
+    rtol, atol, scheduler = run.rtol, run.atol, run.scheduler
     # the fixed point and the section depend on the system and parameters only: a second map of
     # the same gait in this process reuses them (:mod:`amble.analysis.basin_setup`)
     xs, section = setup(system, params, pvec, x_names, snames, rtol, atol, section=to_state is None)
@@ -278,13 +261,47 @@ def basin(
 
     res = run_sweep(kind="basin", columns=basin_columns(x_names), key=["i", "j", *x_names], keys=keys,
                     groups=[list(range(len(av)))], split=shrinking if side_by_side else rows_per_task,
-                    make_task=make_task, fn=_basin_task, out=out, scheduler=scheduler, workers=workers,
-                    progress=progress, max_points=max_points, params=list(x_names), state_names=snames,
+                    make_task=make_task, fn=_basin_task, run=run, params=list(x_names), state_names=snames,
                     threads=threads if side_by_side else 1, ordered=True)  # keys listed row by row: key order
     outcome, st, dist, why = _arrays(res.rows, (len(av), len(bv)))
     return BasinResult(names=tuple(x_names), a_values=av, b_values=bv, outcome=outcome, steps=st, distance=dist,
-                       fixed_point=xs, path=str(out) if out else None, computed=res.computed,
+                       fixed_point=xs, path=str(run.out) if run.out else None, computed=res.computed,
                        state_names=snames, reasons=why)
 
 
-__all__ = ["BASIN_COLUMNS", "BASIN_LABELS", "BasinResult", "basin", "basin_columns"]
+def basin(
+    system: HybridSystem,
+    x_names: tuple[str, str],
+    ranges: tuple[tuple[float, float], tuple[float, float]],
+    n: tuple[int, int] = (100, 100),
+    *,
+    params: Mapping[str, float] | None = None,
+    base_state: Sequence[float] | None = None,
+    to_state: Callable[[float, float, np.ndarray], np.ndarray] | None = None,
+    steps: int = BASIN_STEPS,
+    check_every: int = 5,
+    tol: float = 1e-4,
+    rows_per_task: int = 5,
+    out: str | os.PathLike | None = None,
+    scheduler: Any = None,
+    workers: int | None = None,
+    progress: bool = True,
+    max_points: int | None = None,
+    rtol: float = BASIN_TOL,
+    atol: float = BASIN_TOL,
+    threads: int = 1,
+) -> BasinResult:
+    """Deprecated: ``amble.sweep(system, "basin", {a: np.linspace(*ranges[0], n[0]), b:
+    np.linspace(*ranges[1], n[1])}, ...)`` (the same cells)."""
+    deprecated("basin()", 'amble.sweep(system, "basin", {a: values_a, b: values_b})')
+    if len(set(x_names)) != 2:
+        raise StateError(f"basin: two different coordinates are needed, got {', '.join(x_names)}")
+    if len(n) != 2 or min(n) < 1:
+        raise StateError("need n = (na ≥ 1, nb ≥ 1), steps ≥ 1, check_every ≥ 1, rows_per_task ≥ 1")
+    over = {nm: sweep_values(np.linspace(r[0], r[1], int(c)), nm) for nm, r, c in zip(x_names, ranges, n)}
+    return basin_kind(system, over, params, RunOptions(out, scheduler, workers, progress, max_points, rtol, atol),
+                      base_state=base_state, to_state=to_state, steps=steps, check_every=check_every, tol=tol,
+                      rows_per_task=rows_per_task, threads=threads)
+
+
+__all__ = ["BASIN_COLUMNS", "BASIN_LABELS", "BasinResult", "basin", "basin_columns", "basin_kind"]

@@ -1,4 +1,5 @@
-"""Bifurcation diagrams and Poincaré iterates: where the period-1 gait gives way to period 2, 4...
+"""Bifurcation diagrams (the ``bifurcation`` kind of :func:`amble.sweep`) and Poincaré iterates:
+where the period-1 gait gives way to period 2, 4...
 
 Along a swept parameter the return map is iterated from the previous value's last post-impact
 state (first put on the new value's section, :meth:`~amble.analysis.section.Section.project`): a
@@ -23,10 +24,11 @@ from ..errors import AmbleError, StateError
 from ..simulation.engine import Options, run
 from ..simulation.simulate import parameter_vector
 from .defaults import BIFURCATION_TOL
+from .doubling import period_doubling
 from .runner import chunks, sweep_values
 from .section import Section
 from .store import ResultStore, SweepResult, state_columns
-from .sweep_runner import compiled, point_key, run_sweep, seed_before
+from .sweep_runner import RunOptions, compiled, deprecated, point_key, run_sweep, seed_before
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -121,6 +123,47 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
     return out
 
 
+def bifurcation_kind(system: HybridSystem, over: Mapping[str, np.ndarray], params: Mapping[str, float] | None,
+                     run: RunOptions, *, coordinate: str | int = 0, transient: int = 300, keep: int = 64,
+                     chunk: int = 16, period_tol: float = 1e-6) -> SweepResult:
+    """The ``bifurcation`` kind of :func:`amble.sweep`: post-transient return-map iterates of one
+    coordinate along one parameter.
+
+    At each value the walker takes ``transient`` steps from the previous value's last
+    post-impact state, then ``keep`` more steps whose post-impact ``coordinate`` (name or state index; default the
+    first, the stance angle of a walker, rad) is kept. A chunk (``chunk`` consecutive values, one
+    Dask task)'s first value starts on its
+    period-1 fixed point when one is found (else the model's guess walked in); a carried state
+    is first put on the new section, its section coordinates kept (:mod:`amble.analysis.section`).
+    ``period`` in a row: smallest p with iterates repeating within ``period_tol`` (0 = no period
+    found: chaos or slow transient).
+    A value where the walker falls is recorded ``failed`` with the reason.
+    """
+    (param, v), = over.items()
+    _, _, snames = compiled(system, params, [param])
+    if isinstance(coordinate, str):
+        if coordinate not in snames:
+            raise StateError(f"unknown coordinate {coordinate!r}; known: {', '.join(snames)}")
+        coord = snames.index(coordinate)
+    else:
+        coord = int(coordinate)
+        if not 0 <= coord < len(snames):
+            raise StateError(f"coordinate index {coord} out of range 0..{len(snames) - 1}")
+    if transient < 0 or keep < 1 or chunk < 1:
+        raise StateError("need transient ≥ 0, keep ≥ 1 and chunk ≥ 1")
+    keys = [[point_key(i, float(x))] for i, x in enumerate(v)]
+    rtol, atol = run.rtol, run.atol
+
+    def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:
+        seed = seed_before(store, keys, grp, pts[0], snames, back=1)  # previous value's last state, as stored
+        return (system, dict(params or {}), param, [(g, float(v[g])) for g in pts], seed, coord, transient, keep,
+                rtol, atol, period_tol)
+
+    return run_sweep(kind="bifurcation", columns=_bif_columns(param, snames), key=["i", param], keys=keys,
+                     groups=chunks(list(range(len(v))), chunk), make_task=make_task, fn=_bif_task, run=run,
+                     params=[param], state_names=snames)
+
+
 def bifurcation(
     system: HybridSystem,
     param: str,
@@ -140,50 +183,19 @@ def bifurcation(
     atol: float = BIFURCATION_TOL,
     period_tol: float = 1e-6,
 ) -> SweepResult:
-    """Bifurcation diagram: post-transient return-map iterates of one coordinate along ``param``.
-
-    At each value the walker takes ``transient`` steps from the previous value's last
-    post-impact state, then ``keep`` more steps whose post-impact ``coordinate`` (name or state index; default the
-    first, the stance angle of a walker, rad) is kept. A chunk's first value starts on its
-    period-1 fixed point when one is found (else the model's guess walked in); a carried state
-    is first put on the new section, its section coordinates kept (:mod:`amble.analysis.section`).
-    ``period`` in a row: smallest p with iterates repeating within ``period_tol`` (0 = no period
-    found: chaos or slow transient).
-    A value where the walker falls is recorded ``failed`` with the reason.
-    """
+    """Deprecated: ``amble.sweep(system, "bifurcation", {param: values}, ...)`` (the same rows)."""
+    deprecated("bifurcation()", 'amble.sweep(system, "bifurcation", {param: values})')
     v = sweep_values(values, param, system)
-    _, _, snames = compiled(system, params, [param])
-    if isinstance(coordinate, str):
-        if coordinate not in snames:
-            raise StateError(f"unknown coordinate {coordinate!r}; known: {', '.join(snames)}")
-        coord = snames.index(coordinate)
-    else:
-        coord = int(coordinate)
-        if not 0 <= coord < len(snames):
-            raise StateError(f"coordinate index {coord} out of range 0..{len(snames) - 1}")
-    if transient < 0 or keep < 1 or chunk < 1:
-        raise StateError("need transient ≥ 0, keep ≥ 1 and chunk ≥ 1")
-    keys = [[point_key(i, float(x))] for i, x in enumerate(v)]
-
-    def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:
-        seed = seed_before(store, keys, grp, pts[0], snames, back=1)  # previous value's last state, as stored
-        return (system, dict(params or {}), param, [(g, float(v[g])) for g in pts], seed, coord, transient, keep,
-                rtol, atol, period_tol)
-
-    return run_sweep(kind="bifurcation", columns=_bif_columns(param, snames), key=["i", param], keys=keys,
-                     groups=chunks(list(range(len(v))), chunk), make_task=make_task, fn=_bif_task, out=out,
-                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points, params=[param],
-                     state_names=snames)
+    return bifurcation_kind(system, {param: v}, params, RunOptions(out, scheduler, workers, progress, max_points,
+                                                                   rtol, atol),
+                            coordinate=coordinate, transient=transient, keep=keep, chunk=chunk, period_tol=period_tol)
 
 
 def first_period_doubling_iterates(result: SweepResult) -> float | None:
-    """First swept value whose post-transient iterates repeat with a period ≥ 2, or ``None``
-    (period 0 is skipped: near the flip the transient decays too slowly to show a period)."""
-    p = result.params[0]
-    for r in result.rows:
-        if r["status"] == "ok" and r["period"] not in ("", "0", "1"):
-            return float(r[p])
-    return None
+    """Deprecated: :func:`amble.period_doubling` of a bifurcation diagram (the same value: the
+    first swept value whose post-transient iterates repeat with a period ≥ 2)."""
+    deprecated("first_period_doubling_iterates()", "amble.period_doubling(result)")
+    return period_doubling(result)
 
 
 def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *,
@@ -207,4 +219,4 @@ def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *
     return np.array(rows)
 
 
-__all__ = ["bifurcation", "first_period_doubling_iterates", "poincare_iterates"]
+__all__ = ["bifurcation", "bifurcation_kind", "first_period_doubling_iterates", "poincare_iterates"]

@@ -303,11 +303,7 @@ def _trace(prob: _Problem, u: np.ndarray, start: float, stop: float, max_delta: 
         if locate:
             for kind, a, b in (("fold", tests[0], testn[0]), ("flip", tests[1], testn[1])):
                 if a * b < 0:
-                    try:
-                        br.bifurcations.append(_locate(prob, u, un, kind, tol))
-                    except AmbleError:
-                        near = (br.points[-1], a) if abs(a) < abs(b) else (ptn, b)
-                        br.bifurcations.append(BifurcationPoint(kind, near[0], near[1], located=False))
+                    br.bifurcations.append(_bracketed(prob, u, un, kind, tol, (br.points[-1], a), (ptn, b)))
         br.points.append(ptn)
         u, t, tests = un, tn, testn
         if not lo < u[-1] < hi:
@@ -352,6 +348,43 @@ def _locate(prob: _Problem, ua: np.ndarray, ub: np.ndarray, kind: str, tol: floa
     assert best is not None
     f2, u, J, res = best
     return BifurcationPoint(kind=kind, point=prob.point(u, J, res, 0.0), test=f2)
+
+
+def _bracketed(prob: _Problem, ua: np.ndarray, ub: np.ndarray, kind: str, tol: float,
+               near_a: tuple[BranchPoint, float], near_b: tuple[BranchPoint, float]) -> BifurcationPoint:
+    """The bifurcation between two branch points whose test functions differ in sign, located
+    (:func:`_locate`); when the location fails, the bracketing point with the smaller |test|
+    (``located=False``). ``near_a``, ``near_b``: each end's point and test value."""
+    try:
+        return _locate(prob, ua, ub, kind, tol)
+    except AmbleError:  # ConvergenceError, SimulationError: e.g. the corrector at a branch point
+        pt, test = near_a if abs(near_a[1]) < abs(near_b[1]) else near_b
+        return BifurcationPoint(kind, pt, test, located=False)
+
+
+def locate_flip(system: HybridSystem, param: str, a: tuple[Sequence[float], float], b: tuple[Sequence[float], float],
+                *, params: Mapping[str, float] | None = None, period: int = 1, rtol: float = FIXED_POINT_TOL,
+                atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL) -> BifurcationPoint | None:
+    """The period doubling between two gaits of one branch: where a real multiplier crosses −1.
+
+    ``a``, ``b``: (post-impact state, value of ``param``) of two period-``period`` gaits (fixed
+    points to ``tol``), e.g. neighbouring points of a sweep. ``ψ_flip = det(A + I)`` is evaluated
+    at both; if it changes sign between them, its zero is located on the branch by the secant
+    method with bisection, each iterate corrected onto the branch (:func:`_locate`, the location
+    continuation uses, to :data:`LOCATE_TOL` in the parameter); ``None`` when the signs agree
+    (no flip between them, or two). ``params``: the other parameters, as in the sweep.
+    """
+    prob = _Problem(system, params, param, period, rtol, atol)
+    ends = []
+    for x, lam in (a, b):
+        u = np.r_[np.asarray(x, float), float(lam)]
+        r, J = prob.F(u)
+        ends.append((u, J, float(np.max(np.abs(r)))))
+    (ua, Ja, ra), (ub, Jb, rb) = ends
+    fa, fb = _tests(prob.reduced(ua, Ja))[1], _tests(prob.reduced(ub, Jb))[1]
+    if not fa * fb < 0:
+        return None
+    return _bracketed(prob, ua, ub, "flip", tol, (prob.point(ua, Ja, ra, 0.0), fa), (prob.point(ub, Jb, rb, 0.0), fb))
 
 
 def switch_at_flip(system: HybridSystem, flip: BifurcationPoint, param: str, stop: float, *,
@@ -413,5 +446,5 @@ def cascade(system: HybridSystem, param: str, start: float, stop: float, *, leve
     return out
 
 
-__all__ = ["Branch", "BranchPoint", "BifurcationPoint", "LOCATE_TOL", "cascade", "continue_branch",
+__all__ = ["Branch", "BranchPoint", "BifurcationPoint", "LOCATE_TOL", "cascade", "continue_branch", "locate_flip",
            "switch_at_flip"]

@@ -1,4 +1,4 @@
-"""The ``continuation`` sweep kind: branches of gaits traced by pseudo-arclength
+"""The ``continuation`` kind of :func:`amble.sweep`: branches of gaits traced by pseudo-arclength
 (:mod:`amble.analysis.continuation`) written as the rows of a result file.
 
 One row per branch point and one per located bifurcation. Key ``branch, row, i``: ``branch`` 0
@@ -21,12 +21,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import AmbleError, OutputError
+from ..errors import AmbleError, OutputError, StateError
 from .continuation import Branch, BranchPoint, cascade
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .runner import sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns
-from .sweep_runner import compiled
+from .sweep_runner import RunOptions, compiled, deprecated
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -65,6 +65,49 @@ def branch_rows(b: int, br: Branch, snames: Sequence[str]) -> list[dict[str, Any
     return rows
 
 
+def continuation_kind(system: HybridSystem, over: Mapping[str, np.ndarray], params: Mapping[str, float] | None,
+                      run: RunOptions, *, steps: int = 50, levels: int = 3, guess: Sequence[float] | None = None,
+                      tol: float = RESIDUAL_TOL) -> SweepResult:
+    """The ``continuation`` kind of :func:`amble.sweep`: ``over = {param: (start, stop)}``, the
+    period-1 gait of ``system`` continued in ``param`` from ``start`` to ``stop`` (either way) by
+    pseudo-arclength, following up to ``levels`` − 1 period doublings
+    (:func:`~amble.analysis.continuation.cascade`).
+
+    ``steps``: the largest parameter change per continuation step is |stop − start| / steps.
+    The gait at ``start`` comes from ``guess`` (default: the model's); ``tol``: the residual
+    ``|P(x) − x|∞`` of every point. A branch that cannot be started is one ``failed`` row with the
+    reason. Continuation is sequential: it runs in this process (``scheduler``, ``workers`` and
+    ``max_points`` do not apply). Rows: see the module docstring and :func:`continuation_columns`;
+    the ``reason`` of a branch's last point says why it ended; ``SweepResult.params`` is ``[param]``.
+    """
+    (param, ends), = over.items()
+    if len(ends) != 2:
+        raise StateError(f"continuation: give {param!r} its two ends (start, stop), got {len(ends)} values")
+    start, stop = (float(e) for e in ends)
+    _, _, snames = compiled(system, params, [param])
+    cols = continuation_columns(param, snames)
+    with ResultStore(run.out, cols, ["branch", "row", "i"]) as store:  # typed: a damaged row is not trusted
+        before = len(store.rows)
+        try:
+            branches = cascade(system, param, start, stop, levels=levels, params=params, guess=guess,
+                               max_delta=abs(stop - start) / max(1, steps), rtol=run.rtol, atol=run.atol, tol=tol)
+            rows = [r for b, br in enumerate(branches) for r in branch_rows(b, br, snames)]
+        except AmbleError as e:
+            rows = [{"branch": 0, "row": "point", "i": 0, param: start, "status": "failed",
+                     "reason": f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"}]
+        # a file of another continuation (other range, parameters or model) is refused, not mixed in
+        store.check_keys([tuple(fmt_value(r[c]) for c in ("branch", "row", "i")) for r in rows])
+        first = store.rows.get(("0", "point", "0"))
+        if first is not None and first[param] != fmt_value(start):
+            raise OutputError(f"{str(run.out)!r} holds a continuation from {param} = {first[param]}, not {start}; "
+                              f"use another file")
+        store.append(rows)
+        store.compact()
+        return SweepResult(kind="continuation", params=[param], rows=store.sorted_rows(),
+                          path=str(run.out) if run.out else None, complete=True, computed=len(store.rows) - before,
+                          reused=before, state_names=list(snames), types=dict(cols))
+
+
 def sweep_continuation(
     system: HybridSystem,
     param: str,
@@ -81,38 +124,11 @@ def sweep_continuation(
     atol: float = FIXED_POINT_TOL,
     tol: float = RESIDUAL_TOL,
 ) -> SweepResult:
-    """Continue the period-1 gait of ``system`` in ``param`` from ``start`` to ``stop`` and follow
-    up to ``levels`` − 1 period doublings (:func:`~amble.analysis.continuation.cascade`).
-
-    ``steps``: the largest parameter change per continuation step is |stop − start| / steps.
-    The gait at ``start`` comes from ``guess`` (default: the model's). A branch that cannot be
-    started is one ``failed`` row with the reason. Rows: see the module docstring and
-    :func:`continuation_columns`; the ``reason`` of a branch's last point says why it ended;
-    ``SweepResult.params`` is ``[param]``.
-    """
-    _, _, snames = compiled(system, params, [param])
-    sweep_values([start, stop], param, system)  # finite, inside the parameter's domain
-    cols = continuation_columns(param, snames)
-    with ResultStore(out, cols, ["branch", "row", "i"]) as store:  # typed: a damaged row is not trusted
-        before = len(store.rows)
-        try:
-            branches = cascade(system, param, start, stop, levels=levels, params=params, guess=guess,
-                               max_delta=abs(stop - start) / max(1, steps), rtol=rtol, atol=atol, tol=tol)
-            rows = [r for b, br in enumerate(branches) for r in branch_rows(b, br, snames)]
-        except AmbleError as e:
-            rows = [{"branch": 0, "row": "point", "i": 0, param: start, "status": "failed",
-                     "reason": f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"}]
-        # a file of another continuation (other range, parameters or model) is refused, not mixed in
-        store.check_keys([tuple(fmt_value(r[c]) for c in ("branch", "row", "i")) for r in rows])
-        first = store.rows.get(("0", "point", "0"))
-        if first is not None and first[param] != fmt_value(start):
-            raise OutputError(f"{str(out)!r} holds a continuation from {param} = {first[param]}, not {start}; "
-                              f"use another file")
-        store.append(rows)
-        store.compact()
-        return SweepResult(kind="continuation", params=[param], rows=store.sorted_rows(),
-                          path=str(out) if out else None, complete=True, computed=len(store.rows) - before,
-                          reused=before, state_names=list(snames), types=dict(cols))
+    """Deprecated: ``amble.sweep(system, "continuation", {param: (start, stop)}, ...)`` (the same rows)."""
+    deprecated("sweep_continuation()", 'amble.sweep(system, "continuation", {param: (start, stop)})')
+    ends = sweep_values([start, stop], param, system)  # finite, inside the parameter's domain
+    return continuation_kind(system, {param: ends}, params, RunOptions(out, progress=progress, rtol=rtol, atol=atol),
+                             steps=steps, levels=levels, guess=guess, tol=tol)
 
 
 def bifurcation_rows(result: SweepResult) -> list[dict[str, Any]]:
@@ -124,4 +140,4 @@ def bifurcation_rows(result: SweepResult) -> list[dict[str, Any]]:
             for r in result.rows if r["row"] in ("fold", "flip") and r["status"] == "ok"]
 
 
-__all__ = ["bifurcation_rows", "branch_rows", "continuation_columns", "sweep_continuation"]
+__all__ = ["bifurcation_rows", "branch_rows", "continuation_columns", "continuation_kind", "sweep_continuation"]

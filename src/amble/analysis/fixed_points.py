@@ -1,7 +1,7 @@
 """Fixed-point branches and maps: the period-1 gait continued along one parameter or over a grid
-of two, with step time and Floquet multipliers, and where the branch period-doubles.
+of two, with step time and Floquet multipliers (the ``fixed-point`` kind of :func:`amble.sweep`).
 
-Inside a chunk continuation is sequential: the fixed point of the previous point seeds the next
+Inside a chunk the points are solved in order, warm-started: the fixed point of the previous point seeds the next
 (Newton from a nearby solution converges in a few iterations and stays on the same branch). A
 resumed chunk is seeded from the last converged row stored before it, read back exactly, so a
 resumed sweep equals an uninterrupted one byte for byte (:mod:`amble.analysis.store`).
@@ -12,7 +12,6 @@ Units: angles in rad, angular velocities in rad/s, times in s; parameters in the
 from __future__ import annotations
 
 import json
-import math
 import os
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -22,9 +21,10 @@ import numpy as np
 from ..backend.kernels import build
 from ..errors import AmbleError, StateError
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .doubling import period_doubling
 from .runner import chunks, sweep_values
 from .store import ResultStore, SweepResult, state_columns
-from .sweep_runner import compiled, point_key, run_sweep, seed_before
+from .sweep_runner import RunOptions, compiled, deprecated, point_key, run_sweep, seed_before
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -71,19 +71,64 @@ def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], po
 
 
 def _fp_sweep(system: HybridSystem, pnames: list[str], grid: list[tuple[int, int, tuple]],
-              groups: list[list[int]], *, params: Mapping[str, float] | None, continuation: bool, kind: str,
-              fp_kw: dict[str, Any], **run: Any) -> SweepResult:
+              groups: list[list[int]], *, params: Mapping[str, float] | None, warm_start: bool, kind: str,
+              fp_kw: dict[str, Any], run: RunOptions) -> SweepResult:
     _, _, snames = compiled(system, params, pnames)
     keys = [[point_key(i, j, *vals)] for i, j, vals in grid]
 
     def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:
-        # continuation: seeded by the last converged point before this one in the chunk, as stored (exact)
-        seed = seed_before(store, keys, grp, pts[0], snames) if continuation else None
+        # warm start: seeded by the last converged point before this one in the chunk, as stored (exact)
+        seed = seed_before(store, keys, grp, pts[0], snames) if warm_start else None
         return (system, dict(params or {}), pnames, [grid[g] for g in pts], seed, fp_kw)
 
     return run_sweep(kind=kind, columns=_fp_columns(pnames, snames), key=["i", "j", *pnames], keys=keys,
-                     groups=groups, make_task=make_task, fn=_fp_task, split=None if continuation else 1,
-                     params=pnames, state_names=snames, **run)
+                     groups=groups, make_task=make_task, fn=_fp_task, split=None if warm_start else 1,
+                     params=pnames, state_names=snames, run=run)
+
+
+def fixed_point_kind(system: HybridSystem, over: Mapping[str, np.ndarray], params: Mapping[str, float] | None,
+                     run: RunOptions, *, warm_start: bool = True, chunk: int | None = None,
+                     tol: float = RESIDUAL_TOL) -> SweepResult:
+    """The ``fixed-point`` kind of :func:`amble.sweep`: the period-1 fixed point of the return map
+    at every value of one parameter (a branch), or on the grid of two (a map).
+
+    One parameter: each chunk of ``chunk`` (default 32) consecutive values is one Dask task; inside
+    it the fixed point at one value is the Newton guess at the next (``warm_start=False``: every
+    point from the model's guess). A point that does not converge is recorded ``failed`` with its
+    reason and the next point is seeded from the last converged one (then from the model's guess).
+    Two parameters ``{a: …, b: …}``: one task per value of ``a`` (``i``), warm-started along ``b``
+    (``j``); ``chunk`` does not apply. ``tol``: the residual ``|P(x) − x|∞`` of a fixed point.
+    Rows: ``i`` (index of the first parameter's value), ``j`` (of the second; 0 for a branch), the
+    parameter values, ``status``, ``reason``, fixed point ``x_<state>``, ``step_time`` (s),
+    multipliers (JSON ``[[re, im], ...]``) and their moduli, ``max_modulus``, ``stable``,
+    ``residual``, ``seeded``. ``SweepResult.kind``: ``fixed-point`` or ``fixed-point-map``.
+    """
+    fp_kw = {"rtol": run.rtol, "atol": run.atol, "tol": tol}
+    names = list(over)
+    if len(names) == 1:
+        size = 32 if chunk is None else chunk
+        if size < 1:
+            raise StateError(f"chunk must be at least 1, got {size}")
+        grid = [(i, 0, (float(x),)) for i, x in enumerate(over[names[0]])]
+        groups = chunks(list(range(len(grid))), size)
+        kind = "fixed-point"
+    else:
+        if chunk is not None:
+            raise StateError("chunk applies to a branch of one parameter: a map's task is one row of its grid")
+        va, vb = over[names[0]], over[names[1]]
+        grid = [(i, j, (float(x), float(y))) for i, x in enumerate(va) for j, y in enumerate(vb)]
+        groups = [list(range(i * len(vb), (i + 1) * len(vb))) for i in range(len(va))]
+        kind = "fixed-point-map"
+    return _fp_sweep(system, names, grid, groups, params=params, warm_start=warm_start, kind=kind, fp_kw=fp_kw,
+                     run=run)
+
+
+def _warm_start(continuation: bool | None, warm_start: bool) -> bool:
+    """``warm_start``, or the value of its old name ``continuation`` (with a warning)."""
+    if continuation is None:
+        return warm_start
+    deprecated("the keyword continuation=", "warm_start=", stacklevel=4)
+    return bool(continuation)
 
 
 def sweep_fixed_points(
@@ -92,7 +137,8 @@ def sweep_fixed_points(
     values: Sequence[float],
     *,
     params: Mapping[str, float] | None = None,
-    continuation: bool = True,
+    warm_start: bool = True,
+    continuation: bool | None = None,
     chunk: int = 32,
     out: str | os.PathLike | None = None,
     scheduler: Any = None,
@@ -103,26 +149,13 @@ def sweep_fixed_points(
     atol: float = FIXED_POINT_TOL,
     tol: float = RESIDUAL_TOL,
 ) -> SweepResult:
-    """Fixed-point branch of the return map along ``param`` (1D continuation).
-
-    Each chunk of ``chunk`` consecutive values is one Dask task; inside it the fixed point at
-    one value is the Newton guess at the next (``continuation=False``: every point from the
-    model's guess). A point that does not converge is recorded ``failed`` with its reason and
-    the next point is seeded from the last converged one (then from the model's guess).
-    Rows: ``i`` (index in ``values``), ``j`` = 0, the parameter value, ``status``, ``reason``,
-    fixed point ``x_<state>``, ``step_time`` (s), multipliers (JSON ``[[re, im], ...]``) and
-    their moduli, ``max_modulus``, ``stable``, ``residual``.
-    ``out``: result file (.csv/.parquet), resumed if it exists. ``max_points``: compute at most
-    this many missing points in this call (a deliberately partial run).
-    """
+    """Deprecated: ``amble.sweep(system, "fixed-point", {param: values}, ...)`` (the same rows).
+    ``continuation=``: the old name of ``warm_start=``."""
+    deprecated("sweep_fixed_points()", 'amble.sweep(system, "fixed-point", {param: values})')
     v = sweep_values(values, param, system)
-    if chunk < 1:
-        raise StateError(f"chunk must be at least 1, got {chunk}")
-    grid = [(i, 0, (float(x),)) for i, x in enumerate(v)]
-    groups = chunks(list(range(len(grid))), chunk)
-    return _fp_sweep(system, [param], grid, groups, params=params, continuation=continuation, out=out,
-                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
-                     kind="fixed-point", fp_kw={"rtol": rtol, "atol": atol, "tol": tol})
+    return fixed_point_kind(system, {param: v}, params, RunOptions(out, scheduler, workers, progress, max_points,
+                                                                   rtol, atol),
+                            warm_start=_warm_start(continuation, warm_start), chunk=chunk, tol=tol)
 
 
 def sweep_fixed_points_2d(
@@ -131,7 +164,8 @@ def sweep_fixed_points_2d(
     values: tuple[Sequence[float], Sequence[float]],
     *,
     params: Mapping[str, float] | None = None,
-    continuation: bool = True,
+    warm_start: bool = True,
+    continuation: bool | None = None,
     out: str | os.PathLike | None = None,
     scheduler: Any = None,
     workers: int | None = None,
@@ -141,40 +175,15 @@ def sweep_fixed_points_2d(
     atol: float = FIXED_POINT_TOL,
     tol: float = RESIDUAL_TOL,
 ) -> SweepResult:
-    """Parameter map: fixed points on the grid ``values[0] × values[1]`` of two parameters.
-
-    One Dask task per row ``i`` (first parameter fixed), continuation along the second
-    parameter ``j``. Rows as in :func:`sweep_fixed_points` with both indices and values.
-    """
+    """Deprecated: ``amble.sweep(system, "fixed-point", {a: values_a, b: values_b}, ...)`` (the
+    same rows). ``continuation=``: the old name of ``warm_start=``."""
+    deprecated("sweep_fixed_points_2d()", 'amble.sweep(system, "fixed-point", {a: values_a, b: values_b})')
     a, b = params2
     if a == b:
         raise StateError(f"the two swept parameters must differ, got {a!r} twice")
-    va, vb = sweep_values(values[0], a, system), sweep_values(values[1], b, system)
-    grid = [(i, j, (float(x), float(y))) for i, x in enumerate(va) for j, y in enumerate(vb)]
-    groups = [list(range(i * len(vb), (i + 1) * len(vb))) for i in range(len(va))]
-    return _fp_sweep(system, [a, b], grid, groups, params=params, continuation=continuation, out=out,
-                     scheduler=scheduler, workers=workers, progress=progress, max_points=max_points,
-                     kind="fixed-point-map", fp_kw={"rtol": rtol, "atol": atol, "tol": tol})
+    over = {a: sweep_values(values[0], a, system), b: sweep_values(values[1], b, system)}
+    return fixed_point_kind(system, over, params, RunOptions(out, scheduler, workers, progress, max_points, rtol, atol),
+                            warm_start=_warm_start(continuation, warm_start), tol=tol)
 
 
-def period_doubling(result: SweepResult) -> float | None:
-    """First parameter value where a real multiplier crosses −1 along a 1D branch (linear
-    interpolation between the two neighbouring converged points), or ``None``."""
-    prev = None
-    p = result.params[0]
-    for r in result.rows:
-        if r["status"] != "ok":
-            prev = None
-            continue
-        mults = json.loads(r["multipliers"])
-        real = [re for re, im in mults if abs(im) < 1e-9 * max(1.0, abs(re))]
-        lo = min(real) if real else math.inf
-        cur = (float(r[p]), lo)
-        if prev is not None and math.isfinite(prev[1]) and math.isfinite(lo) and (prev[1] + 1) * (lo + 1) < 0:
-            (x0, y0), (x1, y1) = prev, cur
-            return x0 + (-1 - y0) * (x1 - x0) / (y1 - y0)
-        prev = cur
-    return None
-
-
-__all__ = ["period_doubling", "sweep_fixed_points", "sweep_fixed_points_2d"]
+__all__ = ["fixed_point_kind", "period_doubling", "sweep_fixed_points", "sweep_fixed_points_2d"]

@@ -12,13 +12,16 @@ result file; when every key is present the file is compacted (sorted by key, ato
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..backend.kernels import build
 from ..simulation.simulate import parameter_vector
+from .defaults import FIXED_POINT_TOL
 from .runner import check_params, execute, open_client
 from .store import ResultStore, SweepResult, fmt_value, state_from_row
 
@@ -26,6 +29,30 @@ if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, with
     from ..modelling.hybrid import HybridSystem
 
 Key = tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How a sweep runs, the same for every kind: the result file ``out`` (.csv/.parquet, resumed if
+    it exists), where its tasks run (``scheduler``: ``None`` local worker processes, ``"synchronous"``
+    this process, else a Dask scheduler's address; ``workers``: local processes), the progress bar,
+    the budget ``max_points`` (compute at most this many missing keys in this call: a deliberately
+    partial run) and the integrator tolerances ``rtol``, ``atol`` (already the kind's default when
+    not given)."""
+
+    out: str | os.PathLike | None = None
+    scheduler: Any = None
+    workers: int | None = None
+    progress: bool = True
+    max_points: int | None = None
+    rtol: float = FIXED_POINT_TOL
+    atol: float = FIXED_POINT_TOL
+
+
+def deprecated(old: str, new: str, stacklevel: int = 3) -> None:
+    """Warn that ``old`` is an alias kept for one release: ``new`` replaces it."""
+    warnings.warn(f"{old} is deprecated and will be removed in the next release; use {new}",
+                  DeprecationWarning, stacklevel=stacklevel)
 
 
 def compiled(system: HybridSystem, params: Mapping[str, float] | None,
@@ -61,8 +88,7 @@ def seed_before(store: ResultStore, keys: Sequence[Sequence[Key]], group: Sequen
 
 def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys: Sequence[Sequence[Key]],
               groups: Sequence[Sequence[int]], make_task: Callable[[list[int], Sequence[int], ResultStore], tuple],
-              fn: Callable[..., list[dict[str, Any]]], out: str | os.PathLike | None, scheduler: Any,
-              workers: int | None, progress: bool, max_points: int | None,
+              fn: Callable[..., list[dict[str, Any]]], run: RunOptions,
               split: int | Callable[[int], int] | None = None,
               params: Sequence[str] = (), state_names: Sequence[str] = (), threads: int = 1,
               ordered: bool = False) -> SweepResult:
@@ -78,8 +104,10 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
     at a time on threads of this process (:func:`amble.analysis.runner.execute`); the journal's
     rows are then in the order tasks finish, the compacted file sorted as always. ``ordered``:
     the keys, point by point, are already in key order (a grid listed row by row), so the rows are
-    taken in that order instead of sorted (the same rows, in the same order).
+    taken in that order instead of sorted (the same rows, in the same order). ``run``: the file,
+    scheduler, workers, progress bar and budget (:class:`RunOptions`).
     """
+    out, max_points = run.out, run.max_points
     # the column types let the store ignore a damaged row instead of counting it ok
     with ResultStore(out, dict(columns), key) as store:  # holds the file's lock until the end
         flat = [kk for ks in keys for kk in ks]
@@ -97,14 +125,14 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
             at = 0
             while at < len(pts) and n_sched < budget:
                 step = split(budget - n_sched) if callable(split) else split or len(pts)
-                run = pts[at:at + max(1, step)][: budget - n_sched]
-                tasks.append(make_task(run, grp, store))
-                at += len(run)
-                n_sched += len(run)
+                part = pts[at:at + max(1, step)][: budget - n_sched]
+                tasks.append(make_task(part, grp, store))
+                at += len(part)
+                n_sched += len(part)
         computed = n_sched * per
-        client, close = open_client(scheduler, workers) if tasks else (None, lambda: None)
+        client, close = open_client(run.scheduler, run.workers) if tasks else (None, lambda: None)
         try:
-            execute(client, fn, tasks, store, progress, computed, kind, threads=threads)
+            execute(client, fn, tasks, store, run.progress, computed, kind, threads=threads)
         finally:
             close()
         if ordered:  # one pass over the grid: its rows, in key order
@@ -125,4 +153,4 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
                            types=dict(columns))
 
 
-__all__ = ["compiled", "point_key", "run_sweep", "seed_before"]
+__all__ = ["RunOptions", "compiled", "deprecated", "point_key", "run_sweep", "seed_before"]

@@ -1,10 +1,8 @@
 """``amble sweep``: the command-line glue between :mod:`amble.cli` and the sweep functions.
 
-Turns the parsed options into one call of :func:`~amble.analysis.fixed_points.sweep_fixed_points`,
-:func:`~amble.analysis.fixed_points.sweep_fixed_points_2d`,
-:func:`~amble.analysis.continuation_sweep.sweep_continuation`,
-:func:`~amble.analysis.bifurcation.bifurcation` or :func:`~amble.analysis.basin.basin`, prints a
-short report (or returns it for ``--json``) and draws the plot. Bad input raises
+Turns the parsed options into one call of :func:`~amble.analysis.sweep.sweep` with the kind of
+``--kind``, reads where the gait period-doubles with :func:`~amble.analysis.doubling.period_doubling`,
+prints a short report (or returns it for ``--json``) and draws the plot. Bad input raises
 :class:`amble.cli.UsageError` (exit code 2) before any work starts.
 """
 
@@ -17,11 +15,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.basin import BASIN_LABELS, BasinResult, basin
-from ..analysis.bifurcation import bifurcation, first_period_doubling_iterates
-from ..analysis.continuation_sweep import bifurcation_rows, sweep_continuation
+from ..analysis.basin import BASIN_LABELS, BasinResult
+from ..analysis.continuation_sweep import bifurcation_rows
 from ..analysis.defaults import BASIN_STEPS
-from ..analysis.fixed_points import period_doubling, sweep_fixed_points, sweep_fixed_points_2d
+from ..analysis.doubling import period_doubling
+from ..analysis.sweep import sweep
 from ..simulation.engine import Options
 from .args import UsageError, check_grid_size, load_model, parse_range, parse_sets, robot_options, writable_path
 from .output import write_output
@@ -146,10 +144,9 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
                     summary: dict[str, Any]) -> Any:
     """Fixed-point branch, 2D map or bifurcation diagram; fills ``summary``, returns the result."""
     names = [r[0] for r in ranges]
-    vals = [np.linspace(r[1], r[2], r[3]) for r in ranges]
     if args.kind == "continuation":
         kw = {k: v for k, v in common.items() if k not in ("scheduler", "workers")}  # sequential: this process
-        res = sweep_continuation(system, names[0], ranges[0][1], ranges[0][2], steps=ranges[0][3], **kw)
+        res = sweep(system, "continuation", {names[0]: ranges[0][1:3]}, steps=ranges[0][3], **kw)
         summary["bifurcations"] = bifurcation_rows(res)
         pts = [r for r in res.rows if r["row"] == "point" and r["status"] == "ok"]
         summary["branches"] = [{"branch": b, "period": int(rs[0]["period"]), "points": len(rs),
@@ -157,18 +154,24 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
                                 "stable_points": sum(1 for r in rs if r["stable"] == "true"), "end": rs[-1]["reason"]}
                                for b in sorted({int(r["branch"]) for r in pts})
                                for rs in [[r for r in pts if int(r["branch"]) == b]]]
-    elif args.kind == "bifurcation":
-        res = bifurcation(system, names[0], vals[0], **common)
-        summary["first_period_two"] = first_period_doubling_iterates(res)
+        summary.update(res.counts())
+        return _point_summary(res, names, summary)
+    res = sweep(system, args.kind, {r[0]: np.linspace(r[1], r[2], r[3]) for r in ranges}, **common)
+    if args.kind == "bifurcation":
+        summary["first_period_two"] = period_doubling(res)  # where the diagram shows period two
     elif len(names) == 1:
-        res = sweep_fixed_points(system, names[0], vals[0], **common)
-        summary["period_doubling"] = period_doubling(res)
+        # the flip located on the branch between the two points that bracket it
+        summary["period_doubling"] = period_doubling(res, system, params=common["params"])
         st = [r for r in res.rows if r["status"] == "ok" and r["stable"] == "true"]
         summary["stable_range"] = [float(st[0][names[0]]), float(st[-1][names[0]])] if st else None
     else:
-        res = sweep_fixed_points_2d(system, (names[0], names[1]), (vals[0], vals[1]), **common)
         summary["stable"] = sum(1 for r in res.rows if r["stable"] == "true")
     summary.update(res.counts())
+    return _point_summary(res, names, summary)
+
+
+def _point_summary(res: Any, names: list[str], summary: dict[str, Any]) -> Any:
+    """The counts and the first failures of a sweep over parameters, into ``summary``; returns ``res``."""
     summary.update(points=len(res.rows), computed=res.computed, reused=res.reused, complete=res.complete)
     summary["failures"] = [{**{nm: float(r[nm]) for nm in names}, "reason": r["reason"]}
                            for r in res.rows if r["status"] != "ok"][:20]
@@ -179,8 +182,8 @@ def _run_basin(system: Any, ranges: list[tuple[str, float, float, int]], args: A
                summary: dict[str, Any]) -> BasinResult:
     """Basin of attraction over the two ``--x`` coordinates; fills ``summary``, returns the result."""
     steps = BASIN_STEPS if args.steps is None else args.steps
-    res = basin(system, (ranges[0][0], ranges[1][0]), ((ranges[0][1], ranges[0][2]), (ranges[1][1], ranges[1][2])),
-                (ranges[0][3], ranges[1][3]), steps=steps, threads=getattr(args, "threads", None) or 1, **common)
+    over = {r[0]: np.linspace(r[1], r[2], r[3]) for r in ranges}
+    res = sweep(system, "basin", over, steps=steps, threads=getattr(args, "threads", None) or 1, **common)
     counts = res.counts()
     cells = res.outcome.size
     done = int(np.sum(res.outcome >= 0))
