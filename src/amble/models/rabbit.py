@@ -2,7 +2,7 @@
 
 Point feet, four actuated joints (hips, knees), hybrid zero dynamics (Westervelt et al. 2007).
 
-Links: a torso and two legs of femur and tibia. Parameters as given in the issue after
+Links: a torso and two legs of femur and tibia. Parameters as given after
 Chevallereau et al. 2003 / Westervelt et al. 2007, Table 6.3: torso ``mT`` 20 kg, length 0.625 m,
 centre of mass ``pT`` 0.2 m above the hip, inertia ``IT`` 2.22 kg·m²; femur ``mf`` 6.8 kg,
 ``lf`` 0.4 m, centre of mass ``pf`` 0.163 m from the hip, ``If`` 1.08 kg·m²; tibia ``mt``
