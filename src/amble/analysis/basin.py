@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..backend.abi import CODE
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..errors import ConvergenceError, StateError
 from ..simulation.engine import Options, walk_many
 from .basin_setup import setup
@@ -30,7 +30,7 @@ from .cells import TextRows, fmt_floats, fmt_ints
 from .defaults import BASIN_STEPS, BASIN_TOL
 from .runner import sweep_values
 from .section import Section
-from .sweep_runner import RunOptions, compiled, deprecated, run_sweep
+from .sweep_runner import RunOptions, deprecated, prepared, run_sweep
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -103,7 +103,7 @@ def _basin_task(system: HybridSystem, pvec: list[float], rows: list[tuple[int, f
     state and the section coordinates; built here, in the worker, from the compiled kernels).
     Python work per cell is kept to a few vectorised passes over the task's block: the GIL it
     holds is what keeps threads (and a Dask client receiving rows) from scaling with cores."""
-    k = build(system, derivatives=section is not None)
+    k = compiled(system, derivatives=section is not None)
     mi = 0
     n = k.meta["nx"][mi]
     p = np.asarray(pvec, float)
@@ -220,7 +220,7 @@ def basin_kind(system: HybridSystem, over: Mapping[str, np.ndarray], params: Map
     point and the section are found once per system and parameters in a process
     (:mod:`amble.analysis.basin_setup`): another map of the same gait starts walking at once.
     """
-    k, pvec, snames = compiled(system, params)
+    k, pvec, snames = prepared(system, params)
     x_names = tuple(over)
     for nm in x_names:
         if nm not in snames:

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..errors import StateError
 from ..simulation.memo import Memo
 from .section import Section
@@ -59,7 +59,7 @@ def setup(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.nda
     two are tied on it. Each from the table when the same inputs were seen before."""
     from .poincare import ReturnMap, find_fixed_point
 
-    k = build(system, derivatives=True)
+    k = compiled(system, derivatives=True)
     owners, base = (system, k), (id(system), id(k), np.asarray(pvec, float).tobytes(), _system_key(system))
     key = ("fixed point", *base, bool(params))
     xs = _SETUPS.get(key, *owners)

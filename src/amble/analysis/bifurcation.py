@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..errors import AmbleError, StateError
 from ..simulation.engine import Options, run
 from ..simulation.simulate import parameter_vector
@@ -28,7 +28,7 @@ from .doubling import period_doubling
 from .runner import chunks, sweep_values
 from .section import Section
 from .store import ResultStore, SweepResult, state_columns
-from .sweep_runner import RunOptions, compiled, deprecated, point_key, run_sweep, seed_before
+from .sweep_runner import RunOptions, deprecated, point_key, prepared, run_sweep, seed_before
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -74,7 +74,7 @@ def _bif_task(system: HybridSystem, base: dict[str, float], param: str, points: 
     """Iterate the return map at each value of a chunk, starting from the previous value's last state."""
     from .poincare import default_guess, find_fixed_point
 
-    k = build(system)
+    k = compiled(system)
     mode = k.meta["modes"][0]
     snames = k.meta["state_names"][mode]
     mi = k.mode_index(mode)
@@ -140,7 +140,7 @@ def bifurcation_kind(system: HybridSystem, over: Mapping[str, np.ndarray], param
     A value where the walker falls is recorded ``failed`` with the reason.
     """
     (param, v), = over.items()
-    _, _, snames = compiled(system, params, [param])
+    _, _, snames = prepared(system, params, [param])
     if isinstance(coordinate, str):
         if coordinate not in snames:
             raise StateError(f"unknown coordinate {coordinate!r}; known: {', '.join(snames)}")
@@ -203,7 +203,7 @@ def poincare_iterates(system: HybridSystem, x0: Sequence[float] | None = None, *
                       atol: float = BIFURCATION_TOL) -> np.ndarray:
     """Successive post-impact states (steps+1 × n; row 0 = x0 or the model's guess); rows after
     a fall are absent (the array is shorter)."""
-    k = build(system)
+    k = compiled(system)
     p = parameter_vector(k, params, system)
     mode = k.meta["modes"][0]
     mi = k.mode_index(mode)

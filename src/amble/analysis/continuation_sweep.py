@@ -26,7 +26,7 @@ from .continuation import Branch, BranchPoint, cascade
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .runner import sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns
-from .sweep_runner import RunOptions, compiled, deprecated
+from .sweep_runner import RunOptions, deprecated, prepared
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -84,7 +84,7 @@ def continuation_kind(system: HybridSystem, over: Mapping[str, np.ndarray], para
     if len(ends) != 2:
         raise StateError(f"continuation: give {param!r} its two ends (start, stop), got {len(ends)} values")
     start, stop = (float(e) for e in ends)
-    _, _, snames = compiled(system, params, [param])
+    _, _, snames = prepared(system, params, [param])
     cols = continuation_columns(param, snames)
     with ResultStore(run.out, cols, ["branch", "row", "i"]) as store:  # typed: a damaged row is not trusted
         before = len(store.rows)

@@ -18,13 +18,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..errors import AmbleError, StateError
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .doubling import period_doubling
 from .runner import chunks, sweep_values
 from .store import ResultStore, SweepResult, state_columns
-from .sweep_runner import RunOptions, compiled, deprecated, point_key, run_sweep, seed_before
+from .sweep_runner import RunOptions, deprecated, point_key, prepared, run_sweep, seed_before
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
@@ -41,7 +41,7 @@ def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], po
     """Continuation along one chunk: each converged fixed point seeds the next point."""
     from .poincare import find_fixed_point
 
-    snames = build(system).meta["state_names"][build(system).meta["modes"][0]]
+    snames = compiled(system).meta["state_names"][compiled(system).meta["modes"][0]]
     guess = None if seed is None else np.asarray(seed, float)
     out = []
     for i, j, vals in points:
@@ -73,7 +73,7 @@ def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], po
 def _fp_sweep(system: HybridSystem, pnames: list[str], grid: list[tuple[int, int, tuple]],
               groups: list[list[int]], *, params: Mapping[str, float] | None, warm_start: bool, kind: str,
               fp_kw: dict[str, Any], run: RunOptions) -> SweepResult:
-    _, _, snames = compiled(system, params, pnames)
+    _, _, snames = prepared(system, params, pnames)
     keys = [[point_key(i, j, *vals)] for i, j, vals in grid]
 
     def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:

@@ -21,7 +21,7 @@ import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
 
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..derivation.equations import derive
 from ..derivation.hzd import zero_dynamics
 from ..errors import ModelError
@@ -106,7 +106,7 @@ def zero_dynamics_functions(model: Any) -> _Functions:
 def impact_on_zero_dynamics(system: HybridSystem, params: Mapping[str, float] | None = None) -> ImpactOnZ:
     """The footfall from ``Z ∩ S`` (see the module), at these parameters."""
     mode, model, step = _controlled_mode(system)
-    k = build(system)
+    k = compiled(system)
     p = parameter_vector(k, params, system)
     pv = dict(zip(k.meta["params"], p.tolist()))
     fn = zero_dynamics_functions(model)

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import Kernels, build
+from ..backend.kernels import Kernels, compiled
 from ..errors import ConvergenceError, ModelError, SimulationError, StateError
 from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
@@ -118,7 +118,7 @@ class ReturnMap:
             raise ModelError(f"system {system.name!r} has no step transition: a return map (fixed point, "
                              f"period-k orbit) needs a transition declared with step=True")
         self.system = system
-        self.k: Kernels = build(system, derivatives=True)  # exact Jacobians, the section's chart
+        self.k: Kernels = compiled(system, derivatives=True)  # exact Jacobians, the section's chart
         self.p = parameter_vector(self.k, params, system)
         self.period = period
         self.mode = mode or self.k.meta["modes"][0]

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..errors import ParameterError, SchedulerError, StateError
 from .store import ResultStore
 
@@ -317,7 +317,7 @@ def _pool(threads: int) -> Any:
 # ---------------------------------------------------------------------------- grid helpers
 def check_params(system: HybridSystem, names: Sequence[str]) -> None:
     """Raise :class:`ParameterError` unless every name is a parameter of ``system``."""
-    known = list(build(system).meta["params"])
+    known = list(compiled(system).meta["params"])
     for n in names:
         if n not in known:
             raise ParameterError(f"unknown parameter {n!r}; known: {', '.join(known)}")

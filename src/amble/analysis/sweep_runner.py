@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import build
+from ..backend.kernels import compiled
 from ..simulation.simulate import parameter_vector
 from .defaults import FIXED_POINT_TOL
 from .runner import check_params, execute, open_client
@@ -55,12 +55,12 @@ def deprecated(old: str, new: str, stacklevel: int = 3) -> None:
                   DeprecationWarning, stacklevel=stacklevel)
 
 
-def compiled(system: HybridSystem, params: Mapping[str, float] | None,
+def prepared(system: HybridSystem, params: Mapping[str, float] | None,
              swept: Sequence[str] = ()) -> tuple[Any, np.ndarray, list[str]]:
     """The compiled kernels (built once here, so workers only load them from the disk cache), the
     parameter vector of ``params`` and the state names of the first mode; ``swept`` must be
     parameters of ``system``."""
-    k = build(system)
+    k = compiled(system)
     pvec = parameter_vector(k, params, system)
     check_params(system, swept)
     return k, pvec, list(k.meta["state_names"][k.meta["modes"][0]])
@@ -153,4 +153,4 @@ def run_sweep(*, kind: str, columns: Mapping[str, str], key: Sequence[str], keys
                            types=dict(columns))
 
 
-__all__ = ["RunOptions", "compiled", "deprecated", "point_key", "run_sweep", "seed_before"]
+__all__ = ["RunOptions", "deprecated", "point_key", "prepared", "run_sweep", "seed_before"]

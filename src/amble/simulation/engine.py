@@ -198,7 +198,7 @@ def run(
         raise StateError(f"sensitivities must be True, False or 'state', got {sensitivities!r}")
     if (sensitivities or NEEDS_JACOBIAN[opts.method]) and not k.meta.get("derivatives"):
         raise StateError(f"system {k.meta['name']!r}: sensitivities and the implicit integrator need the kernels "
-                         "built with their derivatives: build(system, derivatives=True)")
+                         "built with their derivatives: amble.compiled(system, derivatives=True)")
     if sensitivities and not abi.HAS_SENSITIVITIES[opts.method]:
         # the variational equations ride on an explicit method's stages
         raise StateError(f"sensitivities need method={' or '.join(map(repr, SENSITIVITY_METHODS))}, "

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..backend.abi import CODE, CTX, NEEDS_JACOBIAN
-from ..backend.kernels import Kernels, build
+from ..backend.kernels import Kernels, compiled
 from ..errors import ParameterError, StateError
 from .engine import RECORD_BUDGET, Options, Run, run
 from .memo import Memo
@@ -177,7 +177,7 @@ def simulate(
         raise StateError(f"sample_dt must be a finite number ≥ 0 s, got {sample_dt}")
     # an implicit integrator's Newton matrix is the exact Jacobian (an unknown name is refused below)
     jacobian = NEEDS_JACOBIAN.get(method or (options.method if options else "dop853"), False)
-    k = build(system, derivatives=jacobian)
+    k = compiled(system, derivatives=jacobian)
     p = parameter_vector(k, params, system)
     mi, x = initial_state(system, k, x0, mode)
     if steps is None and t_end is None:
