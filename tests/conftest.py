@@ -19,8 +19,8 @@ def compass():
 @pytest.fixture(scope="module")
 def compass_built():
     """The library's compass gait and its compiled kernels (its own copy per test module)."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.models import load
 
     system = load("compass-gait")
-    return system, build(system)
+    return system, compiled(system)

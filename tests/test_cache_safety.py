@@ -74,7 +74,7 @@ def test_a_folder_that_is_not_a_cache_is_never_cleaned(tmp_path, monkeypatch, pr
     monkeypatch.chdir(folder)
     monkeypatch.setenv("AMBLE_CACHE_DIR", ".")
     with pytest.warns(cache_home.CacheWarning, match="not an amble cache"):
-        k = kernels.build(_pendulum("not-a-cache"))
+        k = kernels.compiled(_pendulum("not-a-cache"))
     assert k.path.parent == private_tmp / f"amble-cache-{os.getuid()}"
     assert main(["cache", "clear", "--all"]) == 2
     err = capsys.readouterr().err.strip()
@@ -87,7 +87,7 @@ def test_inside_a_cache_only_amble_s_own_leftovers_go(tmp_path, monkeypatch, pri
     a build removes the killed one only; ``cache clear --all`` keeps the user's files."""
     d = tmp_path / "cache"
     monkeypatch.setenv("AMBLE_CACHE_DIR", str(d))
-    kernels.build(_pendulum("inside-a-cache"))
+    kernels.compiled(_pendulum("inside-a-cache"))
     assert (d / cache_home.TAG).read_text().startswith("Signature: 8a477f597d28d172789f06886806bc55")
     (d / "build-release").mkdir()
     (d / "build-release" / "app.bin").write_bytes(b"user's")
@@ -110,7 +110,7 @@ def test_an_earlier_cache_is_adopted_and_the_default_place_always(tmp_path, monk
     d = tmp_path / "earlier"
     monkeypatch.setenv("AMBLE_CACHE_DIR", str(d))
     s = _pendulum("earlier-cache")
-    so = kernels.build(s).path
+    so = kernels.compiled(s).path
     (d / cache_home.TAG).unlink()
     monkeypatch.setattr(kernels, "_BUILT", {}, raising=False)
     with warnings.catch_warnings():
@@ -122,7 +122,7 @@ def test_an_earlier_cache_is_adopted_and_the_default_place_always(tmp_path, monk
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     default = _user_folder(tmp_path / "xdg" / "amble")
     before = _tree(default)
-    kernels.build(_pendulum("default-place"))
+    kernels.compiled(_pendulum("default-place"))
     assert main(["cache", "clear", "--all"]) == 0
     assert _tree(default) == {**before, cache_home.TAG: cache_home.TAG_TEXT.encode()}
 
@@ -154,7 +154,7 @@ def test_a_damaged_index_entry_is_rebuilt_not_fatal(tmp_path, monkeypatch):
     monkeypatch.setenv("AMBLE_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setenv("AMBLE_WARM_START", "1")
     s = _pendulum("damaged-index")
-    kernels.build(s)
+    kernels.compiled(s)
     path = index.record("damaged-index", [], s)
     path.write_bytes(b"\xff\xfe\x00 not utf-8 \x80")
     with pytest.warns(cache_home.CacheWarning, match="unreadable"):
@@ -177,7 +177,7 @@ def test_a_kernel_file_system_falls_back(monkeypatch, private_tmp):
 def test_a_relative_cache_directory_is_made_absolute(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("AMBLE_CACHE_DIR", "rel-cache")
-    k = kernels.build(_pendulum("relative-cache"))
+    k = kernels.compiled(_pendulum("relative-cache"))
     assert cache.cache_dir() == tmp_path / "rel-cache" and k.path.is_absolute()
     assert simulate(_pendulum("relative-cache"), x0=[0.3, 0.0], t_end=0.1).status == "end_time"
 

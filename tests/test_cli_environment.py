@@ -128,8 +128,8 @@ def test_a_writable_file_in_a_read_only_directory_is_refused_before_the_work(tmp
     for name in ("s.csv", ".s.csv.lock"):
         (ro / name).write_text("")
         (tmp_path / name).write_text("")
-    script = ("from amble.analysis.sweep import sweep_fixed_points; from amble.models import load; "
-              f"sweep_fixed_points(load('compass-gait'), 'slope', [0.04, 0.05], out={str(ro / 's.csv')!r}, "
+    script = ("from amble.analysis.sweep import sweep; from amble.models import load; "
+              f"sweep(load('compass-gait'), 'fixed-point', {{'slope': [0.04, 0.05]}}, out={str(ro / 's.csv')!r}, "
               "scheduler='synchronous', progress=False)")
     mounts = (f"mount --bind {ro} {ro} && mount -o remount,bind,ro {ro} && "
               f"mount --bind {tmp_path / 's.csv'} {ro / 's.csv'} && "

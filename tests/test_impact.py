@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.simulation.simulate import parameter_vector
 
 
@@ -29,7 +29,7 @@ def test_derived_impact_equals_goswami(compass, ab):
     # Our model's b is the foot→mass distance and a the hip→mass distance (thesis naming),
     # i.e. Goswami's a is our b.
     a_hip, b_foot = ab
-    k = build(compass)
+    k = compiled(compass)
     p = parameter_vector(k, {"a": a_hip, "b": b_foot})
     rng = np.random.default_rng(1)
     for _ in range(20):
@@ -48,7 +48,7 @@ def _momentum_and_energy(k, p, x, mode=0):
 
 
 def test_impact_conserves_angular_momentum_and_never_adds_energy(compass):
-    k = build(compass)
+    k = compiled(compass)
     p = parameter_vector(k, None)
     rng = np.random.default_rng(7)
     for _ in range(50):
@@ -92,7 +92,7 @@ def test_thesis_reset_written_explicitly_equals_the_derived_impact(compass):
     explicit = HybridSystem("cg-explicit", {"compass-gait": m})
     explicit.transition("heel_strike", "compass-gait", compass.transitions[0].guard,
                         Explicit(q=J * sp.Matrix([st, sw]), qd=Hg * sp.Matrix([std, swd])), step=True)
-    k1, k2 = build(compass), build(explicit)
+    k1, k2 = compiled(compass), compiled(explicit)
     p = parameter_vector(k1, {"a": 0.45, "b": 0.55})
     rng = np.random.default_rng(3)
     for _ in range(10):
@@ -106,7 +106,7 @@ def test_dynamics_kernel_matches_the_symbolic_equations(compass):
 
     m = compass.modes["compass-gait"]
     eq = derive(m)
-    k = build(compass)
+    k = compiled(compass)
     p = parameter_vector(k, None)
     x = np.array([0.1, -0.2, 0.7, -1.3])
     M, h, G = k.dynamics(0, 0.0, x, p)

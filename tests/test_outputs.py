@@ -7,11 +7,12 @@ import csv
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import amble
-from amble.analysis.basin import basin
 from amble.analysis.poincare import find_fixed_point
+from amble.analysis.sweep import sweep
 from amble.cli.main import build_parser, main
 from amble.errors import OutputError
 
@@ -32,17 +33,19 @@ def test_csv_marks_the_pre_and_post_rows_of_each_event(compass, tmp_path):
 
 def test_basin_axis_columns_are_the_coordinates_and_an_old_file_is_refused(compass, tmp_path):
     xs = find_fixed_point(compass).fixed_point
-    grid = (("stance", "stance_dot"), ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.1, xs[2] + 0.1)), (2, 2))
-    res = basin(compass, *grid, steps=10, out=tmp_path / "basin.csv", **SYNC)
+    over = {"stance": np.linspace(xs[0] - 0.05, xs[0] + 0.05, 2),
+            "stance_dot": np.linspace(xs[2] - 0.1, xs[2] + 0.1, 2)}
+    res = sweep(compass, "basin", over, steps=10, out=tmp_path / "basin.csv", **SYNC)
     header = next(csv.reader((tmp_path / "basin.csv").open()))
     assert header[:4] == ["i", "j", "stance", "stance_dot"] and "a" not in header
     assert sum(res.counts().values()) == 4
     old = tmp_path / "old.csv"
     old.write_text("i,j,a,b,outcome,reason,steps,distance\n0,0,-0.27,0.99,converged,,10,1e-05\n", encoding="utf-8")
     with pytest.raises(OutputError, match="different kind of sweep"):
-        basin(compass, *grid, steps=10, out=old, **SYNC)
-    with pytest.raises(amble.StateError, match="two different coordinates"):
-        basin(compass, ("stance", "stance"), grid[1], grid[2], **SYNC)
+        sweep(compass, "basin", over, steps=10, out=old, **SYNC)
+    # a coordinate named twice is one entry of the grid: refused, a basin needs two
+    with pytest.raises(amble.StateError, match="takes 2 entries"):
+        sweep(compass, "basin", dict(zip(("stance", "stance"), over.values())), **SYNC)
 
 
 def test_models_text_is_tidy(capsys):

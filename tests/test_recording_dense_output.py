@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 from scipy.integrate._ivp import dop853_coefficients as dc
 
 import amble
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.backend.runtime import C_DIR
 from amble.models import load
 from amble.simulation.simulate import parameter_vector
@@ -23,7 +23,7 @@ TOL = 1e-8
 @pytest.mark.parametrize("name", ["compass-gait", "kneed-biped"])
 def test_samples_between_events_are_the_solution(name):
     system = load(name)
-    k = build(system)
+    k = compiled(system)
     p = parameter_vector(k, None)
     tr = amble.simulate(system, steps=1, rtol=TOL, atol=TOL, sample_dt=0.002)
     x_start = tr.x[0][np.isfinite(tr.x[0])]

@@ -121,7 +121,7 @@ def test_singular_mass_matrix_is_reported():
 
 
 def test_changing_a_default_is_seen_without_recompiling():
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
 
     def system(g):
         m = _falling_mass()
@@ -131,7 +131,7 @@ def test_changing_a_default_is_seen_without_recompiling():
         return sys_
 
     a, b = system(9.81), system(1.62)
-    assert build(a).path == build(b).path  # one compiled library...
+    assert compiled(a).path == compiled(b).path  # one compiled library...
     ta = amble.simulate(a, [0.0, 1.0, 0.0, 0.0], t_end=5.0).events[-1].t
     tb = amble.simulate(b, [0.0, 1.0, 0.0, 0.0], t_end=5.0).events[-1].t
     assert abs(ta - math.sqrt(2 / 9.81)) < 1e-10 and abs(tb - math.sqrt(2 / 1.62)) < 1e-10  # ...own defaults

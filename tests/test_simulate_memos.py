@@ -6,7 +6,7 @@ import pytest
 
 import amble
 from amble import ParameterError
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.engine import Options, run
 from amble.simulation.simulate import parameter_vector
@@ -49,7 +49,7 @@ def test_a_domain_is_checked_on_every_call(compass_built):
 
 def test_a_new_domain_is_seen_by_the_next_call():
     system = load("compass-gait")
-    k = build(system)
+    k = compiled(system)
     parameter_vector(k, {"a": 0.4}, system)  # inside the default domain
     mode = system.modes[system.mode_names[0]]
     saved = dict(mode.domains)

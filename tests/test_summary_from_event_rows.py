@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import amble
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.engine import Options, run
 from amble.simulation.simulate import parameter_vector
@@ -15,7 +15,7 @@ from amble.simulation.simulate import parameter_vector
 @pytest.mark.parametrize("samples", [True, False])
 def test_post_impact_state_is_where_the_fast_path_ends(samples):
     system = load("compass-gait")
-    k = build(system)
+    k = compiled(system)
     x0 = np.array(system.default_start[k.meta["modes"][0]], float)
     fast = run(k, parameter_vector(k, None), 0, x0, steps=5, opts=Options(max_step_time=system.max_step_time))
     traj = amble.simulate(system, steps=5, samples=samples)

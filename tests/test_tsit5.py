@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 import amble
 from amble import HybridSystem, Model
 from amble.backend.abi import CTX, HAS_SENSITIVITIES, METHODS, NEEDS_JACOBIAN
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.cli.main import main
 from amble.models import load
 from amble.simulation.engine import Options, run
@@ -40,7 +40,7 @@ def test_the_table_row():
 
 def test_a_smooth_model_and_its_dense_output_match_scipy():
     s = _double_pendulum()
-    k = build(s)
+    k = compiled(s)
     p = parameter_vector(k, None, s)
     tr = amble.simulate(s, X0, t_end=3.0, method="tsit5", rtol=TOL, atol=TOL, sample_dt=0.01)
     assert tr.status == "end_time"
@@ -60,7 +60,7 @@ def _first_event(name: str, guard: int, t_free: float = 0.05):
     walkers begin with the guard at zero, and past a swing foot's scuffing, which the guard's
     enabling condition ignores), and amble's Tsit5 run to its first event."""
     s = load(name)
-    k = build(s)
+    k = compiled(s)
     p = parameter_vector(k, None, s)
     mi, x0 = initial_state(s, k, None, None)
     f = lambda t, x: k.rhs(mi, t, x, p)  # noqa: E731
@@ -89,7 +89,7 @@ def test_the_kneed_bipeds_knee_lock_matches_scipy():
 
 def test_the_error_falls_with_the_fifth_power_of_a_fixed_step():
     s = _double_pendulum()
-    k = build(s)
+    k = compiled(s)
     p = parameter_vector(k, None, s)
     x0 = np.array(X0)
     ref = solve_ivp(lambda t, x: k.rhs(0, t, x, p), (0.0, 1.0), x0, **REF).y[:, -1]
@@ -105,7 +105,7 @@ def test_the_error_falls_with_the_fifth_power_of_a_fixed_step():
 
 def test_sensitivities_ride_on_the_tsit5_stages():
     s = load("compass-gait")
-    k = build(s, derivatives=True)
+    k = compiled(s, derivatives=True)
     p = parameter_vector(k, None, s)
     _, x0 = initial_state(s, k, None, None)
     got = {}

@@ -22,7 +22,7 @@ from amble.analysis.cells import TextRows, fmt_floats, fmt_ints, fmt_value
 from amble.analysis.defaults import BASIN_TOL
 from amble.analysis.poincare import find_fixed_point
 from amble.analysis.store import ResultStore
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.errors import ConvergenceError, OutputError
 from amble.simulation.engine import Options
 
@@ -68,7 +68,7 @@ def test_text_rows_append_as_dict_rows(tmp_path):
 
 @pytest.fixture(scope="module")
 def walker(compass):
-    k = build(compass)
+    k = compiled(compass)
     p = np.array(k.meta["param_defaults"], float)
     return k, p, find_fixed_point(compass).fixed_point
 

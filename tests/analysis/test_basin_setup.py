@@ -19,7 +19,7 @@ from amble import sweep
 from amble.analysis import basin_setup
 from amble.analysis.basin import BASIN_LABELS
 from amble.analysis.defaults import BASIN_TOL, FIXED_POINT_TOL
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.engine import Options, run
 
@@ -31,7 +31,7 @@ def _scipy_fixed_point(system, slope: float, guess: np.ndarray) -> np.ndarray:
     """A root of x ↦ P(x) − x in the compass gait's section coordinates (stance, stance rate, swing
     rate; both feet on the slope after a footfall), the map walked by ``engine.run``, solved by
     SciPy's MINPACK hybrid method with its own difference Jacobian."""
-    k = build(system)
+    k = compiled(system)
     p = np.array(k.meta["param_defaults"], float)
     p[k.meta["params"].index("slope")] = slope
     opts = Options(rtol=FIXED_POINT_TOL, atol=FIXED_POINT_TOL, max_step_time=system.max_step_time)
@@ -128,7 +128,7 @@ def test_cells_on_the_section_are_direct_walks(compass, threads):
     av, bv = np.linspace(-0.35, -0.10, 12), np.linspace(0.8, 1.4, 5)
     res = sweep(compass, "basin", dict(zip(AXES, (av, bv))), steps=steps, check_every=every, tol=tol,
                 rows_per_task=5, threads=threads, **SYNC)
-    k = build(compass)
+    k = compiled(compass)
     p = np.array(k.meta["param_defaults"], float)
     xs = res.fixed_point
     opts = Options(rtol=BASIN_TOL, atol=BASIN_TOL, max_step_time=compass.max_step_time)

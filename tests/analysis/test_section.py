@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from amble.analysis.basin import basin
 from amble.analysis.poincare import ReturnMap, find_fixed_point
 from amble.analysis.section import Section, chart
+from amble.analysis.sweep import sweep
 from amble.errors import StateError
 from amble.models import load
 
@@ -58,7 +58,7 @@ def test_chart_refuses_coordinates_tied_on_the_section(compass):
     with pytest.raises(StateError):
         chart(U, prefer=[0, 1])  # stance and swing: tied by the feet on the slope
     with pytest.raises(StateError, match="tied on the section"):
-        basin(compass, ("stance", "swing"), ((-0.3, -0.2), (0.2, 0.3)), (2, 2), **SYNC)
+        sweep(compass, "basin", {"stance": np.linspace(-0.3, -0.2, 2), "swing": np.linspace(0.2, 0.3, 2)}, **SYNC)
 
 
 def test_humanoid_3d_basin_cell_at_the_fixed_point_converges():
@@ -68,8 +68,9 @@ def test_humanoid_3d_basin_cell_at_the_fixed_point_converges():
     sec = Section.of(ReturnMap(s), xs)
     assert np.max(np.abs(sec.project(xs) - xs)) < 1e-12  # the gait lies on its section
     a, b = names.index("stance"), names.index("stance_dot")
-    res = basin(s, ("stance", "stance_dot"), ((xs[a] - 0.01, xs[a] + 0.01), (xs[b] - 0.05, xs[b] + 0.05)), (3, 3),
-                steps=30, **SYNC)
+    over = {"stance": np.linspace(xs[a] - 0.01, xs[a] + 0.01, 3),
+            "stance_dot": np.linspace(xs[b] - 0.05, xs[b] + 0.05, 3)}
+    res = sweep(s, "basin", over, steps=30, **SYNC)
     assert res.outcome[1, 1] == 0  # converged, at the fixed point itself
     # every cell was put on the section and walked; a walk may end in a terminal outcome of the
     # model (the knee-swing foot scuffing the ground), never for want of a section state
@@ -82,8 +83,9 @@ def test_humanoid_3d_yaw_basin_completes(tmp_path, n):
     fixed point itself and converges."""
     s = load("humanoid-3d-yaw")  # the model this basin was measured on
     xs = find_fixed_point(s).fixed_point
-    res = basin(s, ("stance", "stance_dot"), ((xs[0] - 0.05, xs[0] + 0.05), (xs[7] - 0.3, xs[7] + 0.3)), (n, n),
-                steps=30, out=tmp_path / "b.csv", **SYNC)
+    over = {"stance": np.linspace(xs[0] - 0.05, xs[0] + 0.05, n),
+            "stance_dot": np.linspace(xs[7] - 0.3, xs[7] + 0.3, n)}
+    res = sweep(s, "basin", over, steps=30, out=tmp_path / "b.csv", **SYNC)
     c = res.counts()
     assert sum(c.values()) == n * n and c["failed"] == 0
     assert c["converged"] > n * n // 25

@@ -17,7 +17,7 @@ import pytest
 import sympy as sp
 
 from amble import Explicit, Guard, HybridSystem, Model
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.engine import Options, run
 from amble.simulation.simulate import initial_state, parameter_vector
@@ -27,7 +27,7 @@ H = 1e-6
 
 
 def _check(system, x0, *, t_end=math.inf, steps=0, rel=2e-7, h=H, opts=OPTS):
-    k = build(system, derivatives=True)
+    k = compiled(system, derivatives=True)
     p = parameter_vector(k, None, system)
     _, x0 = initial_state(system, k, np.asarray(x0, float), k.meta["modes"][0])
     r = run(k, p, 0, x0, t_end=t_end, steps=steps, opts=opts, sensitivities=True)

@@ -1,4 +1,4 @@
-"""Parameter sweeps: continuation, period doubling, resumable result files, failures, basins, CLI.
+"""Parameter sweeps: warm-started branches, period doubling, resumable result files, failures, basins, CLI.
 
 Truth used here: the return-map fixed-point property P(x*) = x* checked by an independent
 simulation, the compass gait's post-impact section constraint stance + swing = 2·slope (both
@@ -18,15 +18,7 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.analysis.sweep import (
-    BASIN_LABELS,
-    basin,
-    bifurcation,
-    period_doubling,
-    poincare_iterates,
-    sweep_fixed_points,
-    sweep_fixed_points_2d,
-)
+from amble.analysis.sweep import BASIN_LABELS, period_doubling, poincare_iterates, sweep
 from amble.cli.main import main
 from amble.errors import StateError
 
@@ -37,11 +29,16 @@ def _state(row, names):
     return np.array([float(row[f"x_{n}"]) for n in names])
 
 
-def test_continuation_matches_single_fixed_points(compass):
+def _box(names, ranges, n):
+    """A basin's grid: ``n[k]`` evenly spaced values over ``ranges[k]`` (both ends) of ``names[k]``."""
+    return {nm: np.linspace(lo, hi, c) for nm, (lo, hi), c in zip(names, ranges, n)}
+
+
+def test_warm_started_branch_matches_single_fixed_points(compass):
     vals = [0.04, 0.05, 0.06]
-    res = sweep_fixed_points(compass, "slope", vals, **SYNC)
+    res = sweep(compass, "fixed-point", {"slope": vals}, **SYNC)
     assert [r["status"] for r in res.rows] == ["ok"] * 3
-    assert [r["seeded"] for r in res.rows] == ["false", "true", "true"]  # continuation after the first
+    assert [r["seeded"] for r in res.rows] == ["false", "true", "true"]  # warm-started after the first
     for r, s in zip(res.rows, vals):
         x = _state(r, res.state_names)
         single = find_fixed_point(compass, params={"slope": s})
@@ -55,7 +52,7 @@ def test_continuation_matches_single_fixed_points(compass):
 
 
 def test_period_doubling_between_007_and_009(compass):
-    res = sweep_fixed_points(compass, "slope", np.linspace(0.07, 0.09, 5), **SYNC)
+    res = sweep(compass, "fixed-point", {"slope": np.linspace(0.07, 0.09, 5)}, **SYNC)
     first, last = res.rows[0], res.rows[-1]
     assert first["stable"] == "true" and last["stable"] == "false"
     mults = [complex(re, im) for re, im in json.loads(last["multipliers"])]
@@ -65,7 +62,7 @@ def test_period_doubling_between_007_and_009(compass):
 
 
 def test_bifurcation_period_two_beyond_the_flip(compass):
-    res = bifurcation(compass, "slope", [0.07, 0.08], transient=300, keep=8, **SYNC)
+    res = sweep(compass, "bifurcation", {"slope": [0.07, 0.08]}, transient=300, keep=8, **SYNC)
     a, b = res.rows
     assert a["period"] == "1" and b["period"] == "2"
     it = json.loads(b["iterates"])
@@ -76,11 +73,11 @@ def test_bifurcation_period_two_beyond_the_flip(compass):
 
 
 def test_failing_point_is_recorded_and_sweep_goes_on(compass):
-    res = sweep_fixed_points(compass, "slope", [0.0, 0.05], **SYNC)  # no passive gait on level ground
+    res = sweep(compass, "fixed-point", {"slope": [0.0, 0.05]}, **SYNC)  # no passive gait on level ground
     bad, good = res.rows
     assert bad["status"] == "failed" and "ConvergenceError" in bad["reason"]
     assert good["status"] == "ok"
-    bif = bifurcation(compass, "slope", [0.05, 0.12], transient=50, keep=4, **SYNC)
+    bif = sweep(compass, "bifurcation", {"slope": [0.05, 0.12]}, transient=50, keep=4, **SYNC)
     assert bif.rows[0]["status"] == "ok"
     assert bif.rows[1]["status"] == "failed" and "fell" in bif.rows[1]["reason"]
     assert res.counts() == {"ok": 1, "failed": 1}
@@ -91,19 +88,19 @@ def test_interrupted_sweep_resumes_to_identical_file(compass, tmp_path, suffix):
     vals = np.linspace(0.03, 0.08, 7)
     full = tmp_path / f"full{suffix}"
     part = tmp_path / f"part{suffix}"
-    ref = sweep_fixed_points(compass, "slope", vals, chunk=4, out=full, **SYNC)
+    ref = sweep(compass, "fixed-point", {"slope": vals}, chunk=4, out=full, **SYNC)
     assert ref.complete
-    r1 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, max_points=3, **SYNC)
+    r1 = sweep(compass, "fixed-point", {"slope": vals}, chunk=4, out=part, max_points=3, **SYNC)
     assert not r1.complete and r1.computed == 3 and len(r1.rows) == 3
     journal = part if suffix == ".csv" else part.with_name(part.name + ".journal.csv")
     with open(journal, "a") as f:  # a write torn by a kill: a partial last line without newline
         f.write("3,0,0.0566")
-    r2 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, max_points=2, **SYNC)
+    r2 = sweep(compass, "fixed-point", {"slope": vals}, chunk=4, out=part, max_points=2, **SYNC)
     assert r2.reused == 3 and r2.computed == 2
-    r3 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, **SYNC)
+    r3 = sweep(compass, "fixed-point", {"slope": vals}, chunk=4, out=part, **SYNC)
     assert r3.complete and r3.computed == 2 and r3.reused == 5
     assert part.read_bytes() == full.read_bytes()
-    r4 = sweep_fixed_points(compass, "slope", vals, chunk=4, out=part, **SYNC)  # nothing left to do
+    r4 = sweep(compass, "fixed-point", {"slope": vals}, chunk=4, out=part, **SYNC)  # nothing left to do
     assert r4.computed == 0 and len(r4.rows) == 7
     assert part.read_bytes() == full.read_bytes()
 
@@ -112,22 +109,22 @@ def test_file_of_another_grid_is_refused(compass, tmp_path):
     from amble.errors import OutputError
 
     out = tmp_path / "s.csv"
-    sweep_fixed_points(compass, "slope", [0.04, 0.05], out=out, **SYNC)
+    sweep(compass, "fixed-point", {"slope": [0.04, 0.05]}, out=out, **SYNC)
     with pytest.raises(OutputError, match="another sweep"):
-        sweep_fixed_points(compass, "slope", [0.04, 0.06], out=out, **SYNC)
+        sweep(compass, "fixed-point", {"slope": [0.04, 0.06]}, out=out, **SYNC)
 
 
 def test_bifurcation_resume_identical(compass, tmp_path):
     vals = [0.07, 0.08, 0.085]
     kw = dict(transient=40, keep=6, chunk=3, **SYNC)
-    bifurcation(compass, "slope", vals, out=tmp_path / "a.csv", **kw)
-    bifurcation(compass, "slope", vals, out=tmp_path / "b.csv", max_points=1, **kw)
-    bifurcation(compass, "slope", vals, out=tmp_path / "b.csv", **kw)
+    sweep(compass, "bifurcation", {"slope": vals}, out=tmp_path / "a.csv", **kw)
+    sweep(compass, "bifurcation", {"slope": vals}, out=tmp_path / "b.csv", max_points=1, **kw)
+    sweep(compass, "bifurcation", {"slope": vals}, out=tmp_path / "b.csv", **kw)
     assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
 
 
 def test_map_2d_grid(compass):
-    res = sweep_fixed_points_2d(compass, ("slope", "mh"), ([0.04, 0.05], [10.0, 12.0]), **SYNC)
+    res = sweep(compass, "fixed-point", {"slope": [0.04, 0.05], "mh": [10.0, 12.0]}, **SYNC)
     assert len(res.rows) == 4 and res.counts()["ok"] == 4
     for r in res.rows:
         x = _state(r, res.state_names)
@@ -136,14 +133,13 @@ def test_map_2d_grid(compass):
 
 def test_basin_small_grid(compass, tmp_path):
     xs = find_fixed_point(compass).fixed_point
-    res = basin(compass, ("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)),
-                (3, 3), steps=40, out=tmp_path / "basin.csv", **SYNC)
+    over = _box(("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)), (3, 3))
+    res = sweep(compass, "basin", over, steps=40, out=tmp_path / "basin.csv", **SYNC)
     assert res.outcome[1, 1] == BASIN_LABELS.index("converged")  # the fixed point itself
     # stance + 0.1 rad with 0.5 rad/s less: far too slow to vault over the stance foot
     assert res.outcome[2, 0] == BASIN_LABELS.index("fell")
     assert sum(res.counts().values()) == 9
-    again = basin(compass, ("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)),
-                  (3, 3), steps=40, out=tmp_path / "basin.csv", **SYNC)
+    again = sweep(compass, "basin", over, steps=40, out=tmp_path / "basin.csv", **SYNC)
     assert again.computed == 0 and np.array_equal(again.outcome, res.outcome)
 
 
@@ -151,23 +147,23 @@ def test_basin_on_two_threads_equals_one_cell_by_cell(compass):
     """Cells walked by two threads sharing each task's walks: every cell's outcome, steps and
     distance are those of one thread, exactly (a cell is walked whole by one thread)."""
     xs = find_fixed_point(compass).fixed_point
-    grid = (("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)), (3, 5))
-    one = basin(compass, *grid, steps=30, **SYNC)
-    two = basin(compass, *grid, steps=30, threads=2, **SYNC)
+    over = _box(("stance", "stance_dot"), ((xs[0] - 0.1, xs[0] + 0.1), (xs[2] - 0.5, xs[2] + 0.5)), (3, 5))
+    one = sweep(compass, "basin", over, steps=30, **SYNC)
+    two = sweep(compass, "basin", over, steps=30, threads=2, **SYNC)
     assert len({int(v) for v in one.outcome.ravel()}) >= 2  # a map with more than one outcome
     np.testing.assert_array_equal(two.outcome, one.outcome)
     np.testing.assert_array_equal(two.steps, one.steps)
     np.testing.assert_array_equal(two.distance, one.distance)
     with pytest.raises(StateError, match="threads"):
-        basin(compass, *grid, steps=30, threads=0, **SYNC)
+        sweep(compass, "basin", over, steps=30, threads=0, **SYNC)
 
 
 def test_plots(compass, tmp_path):
     from amble.viz import sweep_plots as sp
 
-    fp = sweep_fixed_points(compass, "slope", [0.05, 0.085], **SYNC)
+    fp = sweep(compass, "fixed-point", {"slope": [0.05, 0.085]}, **SYNC)
     assert sp.plot_branch(fp, tmp_path / "b.png").stat().st_size > 1000
-    bif = bifurcation(compass, "slope", [0.05, 0.085], transient=20, keep=4, **SYNC)
+    bif = sweep(compass, "bifurcation", {"slope": [0.05, 0.085]}, transient=20, keep=4, **SYNC)
     assert sp.plot_bifurcation(bif, tmp_path / "bif.svg").stat().st_size > 1000
     it = poincare_iterates(compass, params={"slope": 0.05}, steps=10)
     assert it.shape == (11, 4)
@@ -192,12 +188,12 @@ def test_cli_sweep(tmp_path, capsys):
 
 
 def test_fixed_point_sweep_on_two_dask_workers_equals_the_serial_sweep(compass):
-    """Four slopes in two tasks of two (continuation inside each task) on a local cluster of two
+    """Four slopes in two tasks of two (warm-started inside each task) on a local cluster of two
     worker processes: every row — state, step time, multipliers, seeding — is the serial sweep's,
     digit for digit (the same point is the same computation wherever it runs)."""
     vals = [0.04, 0.05, 0.06, 0.07]
-    serial = sweep_fixed_points(compass, "slope", vals, chunk=2, **SYNC)
-    dist = sweep_fixed_points(compass, "slope", vals, chunk=2, workers=2, progress=False)
+    serial = sweep(compass, "fixed-point", {"slope": vals}, chunk=2, **SYNC)
+    dist = sweep(compass, "fixed-point", {"slope": vals}, chunk=2, workers=2, progress=False)
     assert [r["status"] for r in serial.rows] == ["ok"] * 4
     assert [r["seeded"] for r in serial.rows] == ["false", "true", "false", "true"]
     assert dist.rows == serial.rows
@@ -206,10 +202,9 @@ def test_fixed_point_sweep_on_two_dask_workers_equals_the_serial_sweep(compass):
 @pytest.mark.slow
 def test_local_cluster_matches_serial(compass, tmp_path):
     xs = find_fixed_point(compass).fixed_point
-    kw = dict(n=(6, 6), steps=30)
-    rng = ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.2, xs[2] + 0.2))
-    serial = basin(compass, ("stance", "stance_dot"), rng, **kw, **SYNC)
-    dist = basin(compass, ("stance", "stance_dot"), rng, **kw, workers=2, progress=False, rows_per_task=2)
+    over = _box(("stance", "stance_dot"), ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.2, xs[2] + 0.2)), (6, 6))
+    serial = sweep(compass, "basin", over, steps=30, **SYNC)
+    dist = sweep(compass, "basin", over, steps=30, workers=2, progress=False, rows_per_task=2)
     assert np.array_equal(serial.outcome, dist.outcome)
 
 

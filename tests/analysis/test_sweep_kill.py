@@ -67,9 +67,9 @@ def _keys(path: Path) -> list[tuple[str, str]]:
 
 
 def test_killed_sweep_resumes_to_the_uninterrupted_file(compass, tmp_path, capsys):
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
 
-    build(compass)  # compile once here, so the subprocesses only load it from the cache
+    compiled(compass)  # compile once here, so the subprocesses only load it from the cache
     ref = tmp_path / "uninterrupted.csv"
     assert main(_command(ref)) == 0
     summary = json.loads(capsys.readouterr().out)
@@ -99,9 +99,9 @@ def test_killed_sweep_resumes_to_the_uninterrupted_file(compass, tmp_path, capsy
 
 def test_killed_basin_resumes_to_the_uninterrupted_file(compass, tmp_path, capsys):
     """The same for a basin of attraction written to Parquet (journal beside the final file)."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
 
-    build(compass)
+    compiled(compass)
     cmd = ["sweep", "compass-gait", "--kind", "basin", "--x", "stance=-0.3:-0.15:60", "--x",
            "stance_dot=0.9:1.3:60", "--steps", "60", "--scheduler", "synchronous", "--json"]
     ref = tmp_path / "uninterrupted.parquet"

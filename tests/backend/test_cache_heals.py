@@ -67,7 +67,7 @@ def test_metadata_that_does_not_match_is_rebuilt(tmp_path, monkeypatch):
 def test_the_model_name_is_never_a_path(tmp_path, monkeypatch):
     monkeypatch.setenv("AMBLE_CACHE_DIR", str(tmp_path / "cache"))
     s = _pendulum("../../outside-cache")
-    k = kernels.build(s)
+    k = kernels.compiled(s)
     assert k.path.parent == tmp_path / "cache"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cache"]
     assert all("outside" not in p.name for p in (tmp_path / "cache").iterdir())

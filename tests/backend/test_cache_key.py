@@ -44,7 +44,7 @@ def test_key_ignores_parameter_defaults():
     model.params[sym] = model.params[sym] * 1.5 + 0.25
     assert s1.parameters != s2.parameters
     assert kernels.structure_key(s1) == kernels.structure_key(s2)
-    k1, k2 = kernels.build(s1), kernels.build(s2)
+    k1, k2 = kernels.compiled(s1), kernels.compiled(s2)
     assert k1.path == k2.path
     assert k2.meta["param_defaults"] == [float(s2.parameters[p]) for p in k2.meta["params"]]
 
@@ -63,8 +63,8 @@ def test_build_twice_computes_the_structure_once(monkeypatch):
     real = cache._structure_digest
     monkeypatch.setattr(cache, "_structure_digest", lambda s: calls.append(s) or real(s))
     s = copy.deepcopy(load("compass-gait"))  # a system object not built yet
-    k1 = kernels.build(s)
-    k2 = kernels.build(s)
+    k1 = kernels.compiled(s)
+    k2 = kernels.compiled(s)
     assert k1 is k2
     assert len(calls) == 1
 

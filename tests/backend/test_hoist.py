@@ -10,7 +10,7 @@ import sympy as sp
 
 from amble import Guard, HybridSystem, Model
 from amble.backend.hoist import Hoister
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.simulation.engine import Options, run
 
 
@@ -80,7 +80,7 @@ def _pendulum():
 
 def test_compiled_kernels_follow_parameter_changes():
     # M = m l² is parameter-only: its pivot and reciprocal come from the prelude too
-    k = build(_pendulum())
+    k = compiled(_pendulum())
     src = k.path.with_suffix(".c").read_text()
     assert "p[NPARAM + " in src and "NHOIST" in src
     x = np.array([0.7, -0.4])
@@ -96,7 +96,7 @@ def test_compiled_kernels_follow_parameter_changes():
 def test_run_reads_the_prelude_of_its_own_parameters():
     # small oscillations th = A sin(ωt), ω = √(g/l): the guard at th = A/2 fires at asin(1/2)/ω,
     # for parameter sets in turn (a stale hoisted length or cos(b) would move it)
-    k = build(_pendulum())
+    k = compiled(_pendulum())
     amp, g = 1e-3, 9.81
     for length, b in ((0.5, 0.3), (2.0, 1.1), (0.5, 0.3)):
         omega = math.sqrt(g / length)

@@ -60,7 +60,7 @@ def test_native_and_portable_builds_walk_bitwise_alike(monkeypatch, tmp_path, to
         else:
             monkeypatch.setenv("AMBLE_CFLAGS", flags)
         monkeypatch.setenv("AMBLE_CACHE_DIR", str(tmp_path / (flags or "native").strip("-")))
-        k = kernels.build(system)
+        k = kernels.compiled(system)
         p = parameter_vector(k, {})
         r = run(k, p, 0, x0, steps=20, opts=Options(rtol=tol, atol=tol))
         assert r.code == 2

@@ -7,7 +7,7 @@ from chains import pendulum_chain
 
 from amble import HybridSystem, Model
 from amble.backend import codegen
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 
 
@@ -26,14 +26,14 @@ def _check(k, n: int, rng: np.random.Generator, states: int = 20) -> None:
 @pytest.mark.parametrize("model", ["compass-gait", "kneed-biped"])
 def test_unrolled_solve_matches_lapack(model):
     system = load(model)
-    k = build(system)
+    k = compiled(system)
     _check(k, k.meta["nx"][0] // 2, np.random.default_rng(1))
 
 
 def test_loop_solve_matches_lapack():
     n = codegen.UNROLL_MAX + 2  # past the unrolled size: amble_ldl_solve in amble_core.h
     m = pendulum_chain(n, f"solve_chain{n}")
-    k = build(HybridSystem(m.name, m))
+    k = compiled(HybridSystem(m.name, m))
     assert "amble_ldl_solve(" in k.path.with_suffix(".c").read_text()
     _check(k, n, np.random.default_rng(2), states=5)
 
@@ -49,7 +49,7 @@ def test_singular_mass_matrix_is_refused(n):
     m = Model(f"singular{n}")
     qs = m.coordinates([f"q{i}" for i in range(n)])
     m.point("p", (sum(qs), 0), mass=1)
-    k = build(HybridSystem(m.name, m))
+    k = compiled(HybridSystem(m.name, m))
     with pytest.raises(Exception, match="singular"):
         k.rhs(0, 0.0, np.zeros(2 * n), np.zeros(1))
 

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.errors import StateError
 
 
 @pytest.fixture()
 def kp(compass):
-    k = build(compass)
+    k = compiled(compass)
     return k, np.array(k.meta["param_defaults"], float)
 
 

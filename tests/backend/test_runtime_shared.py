@@ -45,7 +45,7 @@ def test_two_models_link_one_runtime_object(tmp_path, monkeypatch):
         shared = amble.simulate(s, steps=2)
         assert shared.status == "completed"
         mi, x0 = 0, np.asarray(s.default_start[s.mode_names[0]], dtype=float)
-        ref = kernels.build(s)
+        ref = kernels.compiled(s)
         assert np.array_equal(k.rhs(mi, 0.0, x0, np.asarray(ref.meta["param_defaults"])),
                               ref.rhs(mi, 0.0, x0, np.asarray(ref.meta["param_defaults"])))
 

@@ -8,7 +8,7 @@ import pytest
 
 from amble.analysis.poincare import find_fixed_point
 from amble.backend.abi import CODE
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.errors import StateError
 from amble.models import load
 from amble.simulation.engine import Options, run
@@ -17,7 +17,7 @@ from amble.simulation.engine import Options, run
 @pytest.fixture(scope="module")
 def walker():
     system = load("compass-gait")
-    k = build(system)
+    k = compiled(system)
     p = np.array(k.meta["param_defaults"], float)
     xs = find_fixed_point(system).fixed_point
     return system, k, p, xs
@@ -105,7 +105,7 @@ def test_batch_walks_with_every_run_option_as_the_loop_does(walker):
     """Every field of the run options reaches each walk: the implicit integrator (the last field)
     and a finer guard screening give the loop's results bit for bit, not the defaults'."""
     system, _, p, xs = walker
-    k = build(system, derivatives=True)  # Radau needs the Jacobian kernels
+    k = compiled(system, derivatives=True)  # Radau needs the Jacobian kernels
     x0 = np.array([xs, xs + np.array([0.02, -0.02, 0.1, 0.0])])
     for opts in (Options(rtol=1e-8, atol=1e-8, max_step_time=system.max_step_time, method="radau"),
                  Options(rtol=1e-8, atol=1e-8, max_step_time=system.max_step_time, nsub=3)):

@@ -6,7 +6,7 @@ import pytest
 
 from amble import HybridSystem, Model, R, StateError
 from amble.analysis.linearize import linearize
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 
 
 def test_inverted_pendulum_closed_form():
@@ -39,7 +39,7 @@ def test_double_pendulum_against_finite_differences():
     s = HybridSystem("acrobot", m)
     x0 = np.array([0.3, -0.5, 1.1, -0.4])
     A, B = linearize(s, x0, [0.7, -1.3])
-    k = build(s)
+    k = compiled(s)
     p = np.array([k.meta["param_defaults"][i] for i in range(len(k.meta["params"]))])
     h = 1e-6
     fd = np.column_stack([(k.rhs(0, 0.0, x0 + h * e, p) - k.rhs(0, 0.0, x0 - h * e, p)) / (2 * h) for e in np.eye(4)])

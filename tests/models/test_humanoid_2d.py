@@ -6,7 +6,7 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.simulate import parameter_vector
 
@@ -32,7 +32,7 @@ def momenta(system, k, p, mode, x, about=None, points=None):
 
 
 def test_knee_lock_conserves_momenta_and_never_adds_energy(humanoid):
-    k = build(humanoid)
+    k = compiled(humanoid)
     p = parameter_vector(k, None)
     rng = np.random.default_rng(11)
     for _ in range(30):
@@ -49,7 +49,7 @@ def test_knee_lock_conserves_momenta_and_never_adds_energy(humanoid):
 
 
 def test_heel_strike_conserves_angular_momentum_about_the_impact_point(humanoid):
-    k = build(humanoid)
+    k = compiled(humanoid)
     p = parameter_vector(k, None)
     rng = np.random.default_rng(13)
     for _ in range(30):
@@ -98,7 +98,7 @@ def test_step_length_torque_does_the_work_of_eq_35(humanoid):
     # Work–energy: the power of τ₂ = −k_leg L on the swing thigh is τ₂·thigh_dot for
     # L = −x(swing foot) > 0 and zero once the swing foot is ahead (thesis Eq. 35); it is the
     # difference of dE/dt with and without the torque (the PD torque's power cancels).
-    k = build(humanoid)
+    k = compiled(humanoid)
     kleg = 5.0
     on, off = parameter_vector(k, {"kleg": kleg}), parameter_vector(k, {"kleg": 0.0})
     foot = k.meta["points"].index("swing_foot")

@@ -11,7 +11,7 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.simulate import parameter_vector
 
@@ -27,7 +27,7 @@ def humanoid():
 
 @pytest.fixture(scope="module")
 def kernels(humanoid):
-    return build(humanoid)
+    return compiled(humanoid)
 
 
 def _masses(par):

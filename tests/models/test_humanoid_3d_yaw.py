@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from amble import simulate
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.simulate import parameter_vector
 
@@ -48,7 +48,7 @@ def _momentum(k, p, x, about):
 
 
 def test_impact_conserves_3d_angular_momentum_and_never_adds_energy(humanoid):
-    k = build(humanoid)
+    k = compiled(humanoid)
     p = parameter_vector(k, None)
     names = k.meta["points"]
     rng = np.random.default_rng(3)

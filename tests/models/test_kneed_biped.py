@@ -7,7 +7,7 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.simulate import parameter_vector
 
@@ -68,7 +68,7 @@ def random_states(rng, n, constrained):
 def test_knee_lock_conserves_momenta_and_never_adds_energy(kneed, params):
     # The knee impulse is internal to the swing leg, which hangs from the hip; the only external
     # impulse on the robot acts at the stance foot.
-    k = build(kneed)
+    k = compiled(kneed)
     p = parameter_vector(k, params)
     for x in random_states(np.random.default_rng(3), 40, constrained=True):
         mode, post = k.reset("knee_lock", 0.0, x, p)
@@ -83,7 +83,7 @@ def test_knee_lock_conserves_momenta_and_never_adds_energy(kneed, params):
 
 @pytest.mark.parametrize("params", [None, HSU_CHEN, MCGEER])
 def test_heel_strike_conserves_angular_momentum_about_the_impact_point(kneed, params):
-    k = build(kneed)
+    k = compiled(kneed)
     p = parameter_vector(k, params)
     rng = np.random.default_rng(5)
     for _ in range(40):
@@ -152,7 +152,7 @@ def euler_stride(k, p, x, dt=1e-3):
 def test_hsu_chen_published_fixed_point_is_that_of_her_euler_scheme(kneed):
     # Our derived dynamics and impacts, stepped with her dt = 1e-3 Euler scheme, map her published
     # fixed point to itself: the equations agree with hers, and her numbers carry the Euler error.
-    k = build(kneed)
+    k = compiled(kneed)
     p = parameter_vector(k, HSU_CHEN)
     x0 = to_ours(HSU_CHEN_X0)
     np.testing.assert_allclose(euler_stride(k, p, x0), x0, rtol=0, atol=1e-9)
@@ -197,7 +197,7 @@ def test_hsu_chen_accurate_limit_cycle(kneed):
 
 @pytest.mark.slow
 def test_hsu_chen_euler_fixed_point_converges_to_the_accurate_one_at_first_order(kneed):
-    k = build(kneed)
+    k = compiled(kneed)
     p = parameter_vector(k, HSU_CHEN)
     exact = find_fixed_point(kneed, to_ours(HSU_CHEN_X0), params=HSU_CHEN).fixed_point
     errors = []

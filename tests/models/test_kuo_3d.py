@@ -10,7 +10,7 @@ import pytest
 
 from amble import simulate
 from amble.analysis.poincare import find_fixed_point
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import kuo_3d, load
 from amble.simulation.simulate import parameter_vector
 
@@ -35,7 +35,7 @@ def _heel_strike_conserves_angular_momentum(system, n):
     """At 40 random pre-impact states (``n`` coordinates): the angular momentum about the roll axis
     and the pelvis axis through the impact point is the same before and after heel strike, and the
     kinetic energy does not grow."""
-    k = build(system)
+    k = compiled(system)
     p = parameter_vector(k, None)
     rng = np.random.default_rng(17)
     for _ in range(40):

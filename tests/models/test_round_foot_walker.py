@@ -6,7 +6,7 @@ import pytest
 
 from amble import Model, R, rolling_centre, round_foot, simulate, walker
 from amble.analysis.poincare import find_fixed_point
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import load
 from amble.simulation.simulate import parameter_vector
 
@@ -86,7 +86,7 @@ def footfalls(rng, gamma, count):
 def test_impact_conserves_angular_momenta_about_the_contact_and_of_the_trailing_leg_about_the_hip(rfw, params):
     # The only external impulse acts at the new contact; the trailing leg's foot lifts off, so the
     # hip pin is the only impulse on that leg.
-    k = build(rfw)
+    k = compiled(rfw)
     p, v = parameter_vector(k, params), values(k, params)
     for x in footfalls(np.random.default_rng(7), v["slope"], 40):
         swing_contact = kinematics(x, v)[0]["swing_contact"]
@@ -121,7 +121,7 @@ def naive_round_foot_walker():
 
 def test_an_impact_of_the_lowest_point_instead_of_the_material_point_breaks_conservation():
     # what the check above guards against: the constraint on the geometric point is the wrong impact
-    k = build(naive_round_foot_walker())
+    k = compiled(naive_round_foot_walker())
     p, v = parameter_vector(k, None), values(k, None)
     x = next(footfalls(np.random.default_rng(7), v["slope"], 1))
     _, post = k.reset("heel_strike", 0.0, x, p)
@@ -131,7 +131,7 @@ def test_an_impact_of_the_lowest_point_instead_of_the_material_point_breaks_cons
 
 @pytest.mark.parametrize("params", [None, OTHER])
 def test_energy_is_conserved_over_the_swing_and_lost_at_heel_strike(rfw, params):
-    k = build(rfw)
+    k = compiled(rfw)
     v = values(k, params)
     lc = find_fixed_point(rfw, params=params)
     tr = simulate(rfw, lc.fixed_point, params=params, steps=1)
@@ -162,7 +162,7 @@ def test_world_positions_are_continuous_through_the_footfall(rfw):
     jumps = np.abs(np.diff(hip, axis=0)).max(axis=1)
     assert jumps.max() < 0.05
     # and the stance foot's contact moves r Δθ along the slope during a step (rolling, no slip)
-    v = values(build(rfw), None)
+    v = values(compiled(rfw), None)
     foot = tr.world_points()["stance_foot"]
     one = tr.t < tr.events[0].t
     travelled = np.linalg.norm(foot[one][-1] - foot[one][0])
@@ -256,7 +256,7 @@ def scipy_walker(v):
 @pytest.mark.parametrize("params", [None, pytest.param(OTHER, marks=pytest.mark.slow)])
 def test_fixed_point_and_multipliers_agree_with_an_independent_scipy_model(rfw, params):
     lc = find_fixed_point(rfw, params=params)
-    stride = scipy_walker(values(build(rfw), params))
+    stride = scipy_walker(values(compiled(rfw), params))
     y = lc.fixed_point[[0, 2, 3]]
     image, step_time = stride(y)
     np.testing.assert_allclose(image, y, rtol=0, atol=1e-9)  # amble's fixed point is one of SciPy's map

@@ -37,7 +37,7 @@ def test_rabbit_walks_at_0_8_m_per_s_from_standing():
     walker: the collocated impact is the compiled heel-strike reset (its own impulse solve), the
     pre-impact state is on the compiled footfall guard, and the step length is the compiled swing
     foot's position there."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.simulation.simulate import parameter_vector
 
     w = rabbit_walker()
@@ -46,7 +46,7 @@ def test_rabbit_walks_at_0_8_m_per_s_from_standing():
     assert g.step_length / g.step_time == pytest.approx(0.8, rel=1e-9)
     assert g.constraints["contact"]["max_violation"] <= 1e-8
     assert np.abs(g.inputs).max() <= 150.0 + 1e-8
-    k = build(w)
+    k = compiled(w)
     p = parameter_vector(k, None)
     _, post = k.reset("heel_strike", 0.0, g.pre_impact_state, p)
     assert np.abs(post - g.fixed_point).max() <= 1e-9
