@@ -9,7 +9,7 @@ compiled, the shared runtime seeded — :mod:`benchmarks.runtime_seed`; its one-
 row of its own):
 ``amble`` and its code generator are imported first (not timed, as the peer imports SymPy before
 its clock starts); then the Model is written, wrapped in a :class:`amble.HybridSystem` with no
-transitions and built with :func:`amble.backend.kernels.build` — which runs :func:`amble.derive`, generates
+transitions and built with :func:`amble.backend.kernels.compiled` — which runs :func:`amble.derive`, generates
 the C source and compiles it into a shared library. The total is that whole sequence; the
 breakdown (derive / code generation / C compile) comes from timing wrappers put around the three
 internal calls. ``ops`` is :meth:`amble.Equations.count_ops` (M, h, Γ with common subexpressions
@@ -114,7 +114,7 @@ def worker(n: int, check: bool) -> dict[str, Any]:
     model = build_chain(n)
     system = amble.HybridSystem(f"chain{n}", {"swing": model})
     t1 = time.perf_counter()
-    k = kernels.build(system)
+    k = kernels.compiled(system)
     t2 = time.perf_counter()
     eq = captured[0]
     out: dict[str, Any] = {
@@ -256,7 +256,7 @@ def run(quick: bool = False) -> Section:
         "Cold derive + code generation + C compile of an n-link planar pendulum chain (point masses at "
         "the link ends, absolute angles, all masses/lengths/g as run-time parameters). Each amble run is "
         "a fresh Python process with a fresh `AMBLE_CACHE_DIR`. " + SECTION_NOTE + " *total* = writing the Model + "
-        "`amble.backend.kernels.build` (derive, codegen, compile with the default flags of the machine table, "
+        "`amble.backend.kernels.compiled` (derive, codegen, compile with the default flags of the machine table, "
         "load), imports excluded on both sides. "
         + reps_note
         + "SymPy peer: `LagrangesMethod` + `lambdify(cse=True)` in a fresh process per n, one run each, "

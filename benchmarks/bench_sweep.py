@@ -4,8 +4,8 @@ Dask LocalCluster workers.
 In-process (:func:`threads`): the same cells walked one ``engine.run`` call per run of footfalls
 (the loop basin maps used before) and in blocks by ``engine.walk_many`` (one compiled call per
 block, ``amble_walk_batch``), each on a thread pool of 1 and 2 threads; one ``walk_many`` batch
-whose rows 1 or 2 threads take one at a time (``threads=``); and ``basin()`` itself in this process
-(12 × 12 and 40 × 40 maps, tasks side by side on the threads). Throughput in walks per second and
+whose rows 1 or 2 threads take one at a time (``threads=``); and ``sweep(system, "basin", ...)``
+itself in this process (12 × 12 and 40 × 40 maps, tasks side by side on the threads). Throughput in walks per second and
 per core, medians of interleaved repeats, and the share of a one-thread run spent outside the
 compiled calls (holding the GIL), split into a basin's set-up and its Python per cell. The goal:
 the batched path and basin maps scale ≥ 1.8× from 1 to 2 threads.
@@ -38,12 +38,19 @@ from benchmarks.common import Goal, Section, table
 
 #: Goal: throughput of the batched path on 2 threads ÷ on 1 thread.
 GOAL_SCALING = 1.8
+#: How the rows and goals of an in-process basin map name the call they time.
+BASIN_ROW = '`sweep(…, "basin", …)`'
+
+
+def _box(n: int) -> dict[str, np.ndarray]:
+    """The basin grid: n post-impact stance angles −0.35…−0.10 rad × n stance velocities 0.8…1.4 rad/s."""
+    return {"stance": np.linspace(-0.35, -0.10, n), "stance_dot": np.linspace(0.8, 1.4, n)}
 
 
 def _warm(system) -> None:
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
 
-    build(system, derivatives=True)  # what a basin task loads (the section projection needs them)
+    compiled(system, derivatives=True)  # what a basin task loads (the section projection needs them)
 
 
 def _cpu() -> float:
@@ -59,7 +66,7 @@ def _one(system, n: int, workers: int, steps: int) -> tuple[float, float, dict[s
     workers got while computing."""
     from dask.distributed import Client, LocalCluster, get_task_stream
 
-    from amble.analysis.sweep import basin
+    from amble.analysis.sweep import sweep
 
     t0 = time.perf_counter()
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
@@ -69,8 +76,7 @@ def _one(system, n: int, workers: int, steps: int) -> tuple[float, float, dict[s
     try:
         w0, c0 = client.run(_cpu), time.process_time()
         with get_task_stream(client) as ts:
-            res = basin(system, ("stance", "stance_dot"), ((-0.35, -0.10), (0.8, 1.4)), (n, n), steps=steps,
-                        scheduler=client, progress=False)
+            res = sweep(system, "basin", _box(n), steps=steps, scheduler=client, progress=False)
         t2 = time.perf_counter()
         w1, c1 = client.run(_cpu), time.process_time()
         compute = sum(ss["stop"] - ss["start"] for t in ts.data for ss in t["startstops"] if ss["action"] == "compute")
@@ -85,10 +91,10 @@ def _one(system, n: int, workers: int, steps: int) -> tuple[float, float, dict[s
 def _cells(system, n: int):
     """(kernels, parameters, fixed point, n² initial post-impact states around the fixed point)."""
     from amble.analysis.poincare import find_fixed_point
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.simulation.simulate import parameter_vector
 
-    k = build(system)
+    k = compiled(system)
     p = parameter_vector(k, {"slope": 0.05})
     xs = find_fixed_point(system, params={"slope": 0.05}).fixed_point
     a, b = np.meshgrid(np.linspace(-0.35, -0.10, n), np.linspace(0.8, 1.4, n), indexing="ij")
@@ -101,11 +107,11 @@ def _cells(system, n: int):
 def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
     """Walks per second (and per core) on 1 and 2 threads of: the one-call-per-run loop and
     ``walk_many`` in fixed blocks, both on a thread pool; one ``walk_many(threads=)`` batch whose
-    rows the threads take one by one; and ``basin()`` in this process (``threads=``), which
+    rows the threads take one by one; and a basin sweep in this process (``threads=``), which
     also puts every cell on the section in Python."""
     from amble.analysis import basin_setup
-    from amble.analysis.basin import basin
     from amble.analysis.defaults import BASIN_TOL
+    from amble.analysis.sweep import sweep
     from amble.models import load
     from amble.simulation.engine import Options, run, walk_many
 
@@ -131,13 +137,12 @@ def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
         walk_many(k, p, 0, xb, xs, steps=steps, check_every=every, tol=tol, opts=opts)
 
     pools = {w: ThreadPoolExecutor(w) for w in (1, 2)}
-    box = (("stance", "stance_dot"), ((-0.35, -0.10), (0.8, 1.4)))
     small, big = (12, 24) if quick else (12, 40)  # basin maps: the earlier 12 × 12, and one whose cells dominate
 
     def bas(m: int, w: int, kept: bool = False):
         if not kept:  # each call works out its fixed point and section, as a first call in a process does
             basin_setup.forget()
-        return basin(system, *box, (m, m), steps=steps, scheduler="synchronous", progress=False, threads=w)
+        return sweep(system, "basin", _box(m), steps=steps, scheduler="synchronous", progress=False, threads=w)
 
     paths = {
         "one call per run (Python loop), blocks on a pool": (lambda w: list(pools[w].map(loop, blocks)), len(x0)),
@@ -181,7 +186,7 @@ def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
         if h is not None:
             # basin tasks run side by side: their Python overlaps the other thread's compiled walks,
             # only the set-up runs alone; one batch's own Python (thread starts) runs alone
-            s0 = (setup_kept if "kept" in name else setup)[1] if name.startswith("`basin()`") else outside
+            s0 = (setup_kept if "kept" in name else setup)[1] if name.startswith(BASIN_ROW) else outside
             bound = total / (s0 + max(outside - s0, (total - s0) / 2))
             data[name].update(gil_share=h, serial_s=outside, bound_2_cores=bound)
         rows.append([name, f"{cells / t1:,.0f}", f"{cells / t2:,.0f}", f"{cells / t1:,.0f}", f"{cells / t2 / 2:,.0f}",
@@ -196,7 +201,7 @@ def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
     for m in (small, big):
         b = data[_basin_row(m)]
         b["serial_per_cell_s"] = (b["serial_s"] - setup[1]) / (m * m - 1)
-        goals.append(Goal(f"`basin()` {m} × {m} in process, 2 threads ÷ 1 thread", f"≥ {GOAL_SCALING:g}×",
+        goals.append(Goal(f"{BASIN_ROW} {m} × {m} in process, 2 threads ÷ 1 thread", f"≥ {GOAL_SCALING:g}×",
                           f"{b['scaling']:.2f}× (best of each: {b['scaling_best']:.2f}×; GIL held "
                           f"{b['gil_share'] * 100:.1f} %: ≤ {b['bound_2_cores']:.2f}× on two free cores)",
                           b["scaling"] >= GOAL_SCALING))
@@ -221,10 +226,10 @@ def threads(quick: bool = False) -> tuple[str, list[Goal], dict]:
 
 
 def _basin_row(m: int, kept: bool = False) -> str:
-    """The row of an m × m ``basin()``: its set-up worked out in the call (the goal's), or ``kept``
+    """The row of an m × m basin sweep: its set-up worked out in the call (the goal's), or ``kept``
     from an earlier call with the same system and parameters (:mod:`amble.analysis.basin_setup`)."""
     how = "set-up kept from the call before" if kept else "with its set-up"
-    return f"`basin()` in process, {m} × {m}, `threads=` ({how}; the section projection)"
+    return f"{BASIN_ROW} in process, {m} × {m}, `threads=` ({how}; the section projection)"
 
 
 def _gil_share(k, fn, reps: int = 3) -> tuple[float, float, float]:
@@ -232,10 +237,10 @@ def _gil_share(k, fn, reps: int = 3) -> tuple[float, float, float]:
     this thread): the part that holds the GIL; those seconds and the call's. Of ``reps`` calls,
     the one with the least time outside (the serial part is what this estimates; the least is
     the one least inflated by the machine, and set-up and map are then compared alike)."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.models import load
 
-    kernels = {id(x): x for x in (k, build(load("compass-gait"), derivatives=True))}.values()
+    kernels = {id(x): x for x in (k, compiled(load("compass-gait"), derivatives=True))}.values()
     inside = [0.0]
     saved = []
     for kk in kernels:
@@ -267,11 +272,11 @@ def run(quick: bool = False) -> Section:
     md, goals, data = threads(quick)
     parts = ["### In one process: 1 and 2 threads", "", md]
     if not quick:
-        from amble.backend.kernels import build
+        from amble.backend.kernels import compiled
         from amble.models import load
 
         system = load("compass-gait")
-        build(system)
+        compiled(system)
         n, steps = 100, 60
         cells = n * n
         rows, reps = [], 3
@@ -310,16 +315,15 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=100, help="grid size per axis (default 100)")
     ap.add_argument("--steps", type=int, default=60, help="footfalls per cell at most (default 60)")
     args = ap.parse_args()
-    from amble.analysis.sweep import basin
-    from amble.backend.kernels import build
+    from amble.analysis.sweep import sweep
+    from amble.backend.kernels import compiled
     from amble.models import load
 
     system = load("compass-gait")
-    build(system)  # compile once, outside the timings
+    compiled(system)  # compile once, outside the timings
     cells = args.n * args.n
     t0 = time.perf_counter()
-    ref = basin(system, ("stance", "stance_dot"), ((-0.35, -0.10), (0.8, 1.4)), (args.n, args.n),
-                steps=args.steps, scheduler="synchronous", progress=False)
+    ref = sweep(system, "basin", _box(args.n), steps=args.steps, scheduler="synchronous", progress=False)
     t_serial = time.perf_counter() - t0
     print(f"{args.n} × {args.n} basin map, ≤ {args.steps} steps per cell: {ref.counts()}")
     print(f"in-process (no Dask):  {t_serial:6.2f} s   {cells / t_serial:8.0f} initial conditions/s")

@@ -64,12 +64,12 @@ WP_PLOT = Path(__file__).resolve().parent / "work_precision.png"
 
 def _amble_setup() -> tuple[Any, Any, Any]:
     """(system, kernels, parameter vector) of the compass gait with Drake's slope."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.models import load
     from amble.simulation.simulate import parameter_vector
 
     system = load("compass-gait")
-    k = build(system)
+    k = compiled(system)
     return system, k, parameter_vector(k, DRAKE_PARAMS)
 
 
@@ -204,14 +204,14 @@ def recording(system: Any, k: Any, p: np.ndarray, x0: np.ndarray, quick: bool) -
 
 def humanoid(quick: bool) -> tuple[str, list[Goal]]:
     """humanoid-3d on the fast path from its default start: µs per walking step."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.models import load
     from amble.simulation.engine import Options, run
     from amble.simulation.simulate import initial_state, parameter_vector
     from benchmarks.peers import compass_scipy, floor
 
     system = load("humanoid-3d")
-    k = build(system)
+    k = compiled(system)
     p = parameter_vector(k, None)
     mi, x = initial_state(system, k, None, None)
     opts = Options(max_step_time=system.max_step_time)
@@ -267,7 +267,7 @@ def library_models(quick: bool) -> tuple[str, list[Goal]]:
     """Every library model on the fast path from its default start, before and after the lean
     right-hand side (hoisted parameter-only subexpressions, the sparse solve), interleaved run by
     run (and the C floor, a compass gait)."""
-    from amble.backend.kernels import build
+    from amble.backend.kernels import compiled
     from amble.models import load, names
     from amble.simulation.engine import Options, run
     from amble.simulation.simulate import initial_state, parameter_vector
@@ -278,7 +278,7 @@ def library_models(quick: bool) -> tuple[str, list[Goal]]:
     for name in names():
         print(f"walk: library model {name} ...", flush=True)
         system = load(name)
-        k_new, k_old = build(system), _unhoisted(system)
+        k_new, k_old = compiled(system), _unhoisted(system)
         p = parameter_vector(k_new, None)
         mi, x = initial_state(system, k_new, None, None)
         opts = Options(max_step_time=system.max_step_time)
