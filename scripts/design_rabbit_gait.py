@@ -16,12 +16,12 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize
 
 from amble.analysis.hzd import invariant_parameters, restricted_map, zero_dynamics_functions
-from amble.backend.kernels import build
+from amble.backend.kernels import compiled
 from amble.models import rabbit
 
 system = rabbit.build()
 model = system.modes["rabbit"]
-kernels = build(system)
+kernels = compiled(system)
 fn = zero_dynamics_functions(model)
 foot = sp.lambdify([*model.q, *model.params], list(model.points["swing_foot"]), cse=True)
 INTERIOR = [(i, k) for i in range(4) for k in (2, 3, 4)]

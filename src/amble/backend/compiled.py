@@ -4,7 +4,7 @@ A :class:`CompiledSystem` stands in for a :class:`~amble.modelling.hybrid.Hybrid
 numbers are needed — simulating, return maps, fixed points and their multipliers, sweeps: its
 names (modes, states, parameters, points, transitions), the parameters' defaults, domains and
 units, the default start and fixed-point guess, the step-time limit, how each transition moves
-the frame (``frame_change``), the walker's hip. :func:`amble.backend.kernels.build` returns its
+the frame (``frame_change``), the walker's hip. :func:`amble.backend.kernels.compiled` returns its
 kernels. It is made by the warm-start index (:mod:`amble.backend.index`) from a small JSON
 (:func:`describe`) written when the model was last built.
 

@@ -1,4 +1,4 @@
-"""Compiled kernels: the ctypes view of a system's compiled library, and :func:`build`, which
+"""Compiled kernels: the ctypes view of a system's compiled library, and :func:`compiled`, which
 loads it from the in-process cache, the disk cache (:mod:`amble.backend.cache`, which also
 decides the cache key and compiles), or a fresh build.
 
@@ -74,7 +74,7 @@ def compiled(system: HybridSystem, derivatives: bool = False) -> Kernels:
     return k
 
 
-#: What :func:`build` served, by (id of the system, derivatives asked, its
+#: What :func:`compiled` served, by (id of the system, derivatives asked, its
 #: :func:`~amble.backend.cache.fingerprint`, the :func:`~amble.backend.cache.settings` its key
 #: reads) → (weak reference to the system, kernels): working out the key and the defaults again
 #: took longer than the rest of a short :func:`~amble.simulation.simulate.simulate` call's
@@ -87,7 +87,7 @@ build = compiled
 
 
 def _load(system: HybridSystem, derivatives: bool) -> Kernels:
-    """The kernels of ``system``, without the table of served ones (see :func:`build`)."""
+    """The kernels of ``system``, without the table of served ones (see :func:`compiled`)."""
     plain = cache.structure_key(system)
     full = cache.derivatives_key(plain)
     k = _LOADED.get(full) or (None if derivatives else _LOADED.get(plain))
@@ -226,7 +226,7 @@ class Kernels:
     def _need_derivatives(self) -> None:
         if not self.meta.get("derivatives"):
             raise ModelError(f"system {self.meta['name']!r}: these kernels were built without their derivatives; "
-                             "use build(system, derivatives=True)")
+                             "use amble.compiled(system, derivatives=True)")
 
     def rhs_jacobian(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
