@@ -138,6 +138,7 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         w(f"#define NX_FIXED {nx[0]}\n")
     w(f"#define NPOINTS {len(points)}\n#define NPARAM {max(len(params), 1)}\n")
     w("#define SC (NXMAX + NPARAM)\n")  # columns of a sensitivity row: state, then parameters
+    w(_slot_map(modes, params))
     w(f"AMBLE_HIDDEN const int MODE_NX[NMODES] = {{{', '.join(map(str, nx))}}};\n")
     w(f"AMBLE_HIDDEN const int MODE_NTR[NMODES] = {{{', '.join(str(len(trs_by_mode[m])) for m in modes)}}};\n")
     w(f"AMBLE_HIDDEN const int MODE_TR0[NMODES] = {{{', '.join(map(str, tr0))}}};\n")
@@ -300,6 +301,21 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         "derivatives": derivatives,
     }
     return "".join(out), meta
+
+
+def _slot_map(modes: dict[str, ModeInfo], params: list[str]) -> str:
+    """A comment naming what each slot of the state ``x`` and the parameters ``p`` holds: the
+    kernels below read them by index."""
+    def c(text: str) -> str:  # a name cannot end the comment early
+        return text.replace("*/", "* /")
+
+    lines = ["/* Slots read by the kernels of this unit (x: the state of the mode, p: the parameters;",
+             " * p[NPARAM + j] are parameter-only values computed once per call, amble_params_prelude)."]
+    for name, mi in modes.items():
+        names = mi.model.state_names
+        lines.append(f" * mode {mi.index} {c(name)!r}: " + ", ".join(f"x[{i}] {c(v)}" for i, v in enumerate(names)))
+    lines.append(" * parameters: " + (", ".join(f"p[{i}] {c(v)}" for i, v in enumerate(params)) or "none"))
+    return "\n".join(lines) + " */\n"
 
 
 def _rhs_surfaces_code(k: int, nx: int, ntr: int, nsw: int) -> str:
