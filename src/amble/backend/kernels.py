@@ -161,8 +161,9 @@ class Kernels:
         lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
         self.simulate_raw = lib.amble_simulate
         lib.amble_walk_batch.restype = None
-        lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 5 + \
-            [ctypes.c_int64, ctypes.c_int64, ctypes.c_double] + [ctypes.c_void_p] * 5
+        lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 2 + \
+            [ctypes.c_int64] + [ctypes.c_void_p] * 3 + [ctypes.c_int64, ctypes.c_int64, ctypes.c_double] + \
+            [ctypes.c_void_p] * 5
         self._walk_batch = lib.amble_walk_batch
         lib.amble_project_batch.restype = None
         lib.amble_project_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int,
@@ -280,7 +281,8 @@ class Kernels:
         """Walk every row of ``x0`` (initial states of ``mode`` at t = 0) for up to ``steps``
         footfalls in one compiled call (which releases the GIL), in runs of ``check_every``
         footfalls each started afresh from the last one's final state, stopping a walk when
-        ``max |x − xref| < tol`` after a run. ``opt``/``iopt``: the run option layouts of
+        ``max |x − xref| < tol`` after a run. ``p``: the parameters of every walk, or one row per
+        walk (``n × len(params)``). ``opt``/``iopt``: the run option layouts of
         :mod:`amble.backend.abi` (capacities ignored: nothing is recorded). ``threads`` > 1:
         that many threads call it at once on the same rows, taking the next unwalked row each
         (one atomic counter), so unequal walks keep every thread busy to the end; each walk is
@@ -302,13 +304,17 @@ class Kernels:
         opt = np.ascontiguousarray(opt, dtype=float)
         iopt = np.ascontiguousarray(iopt, dtype=np.int64)
         p = np.ascontiguousarray(p, dtype=float)
+        npar = len(self.meta["params"])
+        if p.ndim == 2 and p.shape != (n, npar) or p.ndim not in (1, 2):
+            raise StateError(f"parameters must be one vector or one row of {npar} per walk, got shape {p.shape}")
+        stride = npar if p.ndim == 2 else 0
         out = {"code": np.zeros(n, dtype=np.int32), "info": np.zeros(n, dtype=np.int32),
                "steps": np.zeros(n, dtype=np.int64), "distance": np.zeros(n), "x": np.zeros((n, self.nx_max))}
         addr = lambda a: a.ctypes.data  # noqa: E731
         threads = min(threads, n)
         counter = np.zeros(1, dtype=np.int64)
-        args = (n, addr(counter) if threads > 1 else None, mi, addr(xs), addr(p), addr(opt), addr(iopt), addr(xref),
-                int(steps), int(check_every), float(tol),
+        args = (n, addr(counter) if threads > 1 else None, mi, addr(xs), addr(p), stride, addr(opt), addr(iopt),
+                addr(xref), int(steps), int(check_every), float(tol),
                 *(addr(out[k]) for k in ("code", "info", "steps", "distance", "x")))
         if threads <= 1:
             self._walk_batch(*args)

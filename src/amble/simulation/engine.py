@@ -265,7 +265,8 @@ def walk_many(k: Kernels, p: np.ndarray, mode: int, x0: np.ndarray, xref: np.nda
               check_every: int, tol: float, opts: Options = Options(), threads: int = 1) -> dict[str, Any]:
     """Walk every row of ``x0`` from t = 0 for up to ``steps`` footfalls in one compiled call (no
     recording, the GIL released): in runs of ``check_every`` footfalls, each started like
-    :func:`run` from the previous one's final state, until ``max |x − xref| < tol``. Returns per
+    :func:`run` from the previous one's final state, until ``max |x − xref| < tol``; ``p`` is one
+    parameter vector for all walks or one row per walk. Returns per
     walk ``code``, ``status`` (as :attr:`Run.status`), ``steps``, ``distance`` (NaN if no run
     completed) and the final ``x`` — what a loop over :func:`run` gives, without its Python cost
     per walk (which kept two threads of basin cells at about 1.2× one). ``threads``: walk the rows

@@ -24,7 +24,8 @@ static void batch_ctx(double *ctx, int mode, const double *x) {
  * footfalls, in runs of `check_every` footfalls each started afresh from the previous run's
  * final state; after each run the walk stops if max_i |x_i - xref_i| < tol. opt and iopt are the
  * option layouts of the runs (end time, tolerances, caps; capacities are ignored: nothing is
- * recorded). Per walk: the status of its last run (ST_STEPS_DONE if all runs completed), the
+ * recorded). The parameters of walk r are p[r * p_stride ...]: p_stride 0 shares one vector, NPARAM
+ * gives each walk its own (a terrain drawn per walk and step). Per walk: the status of its last run (ST_STEPS_DONE if all runs completed), the
  * index of the transition that ended it (or -1), the footfalls taken, the last distance (NaN if
  * no run completed) and the final state (NaN-padded to NXMAX).
  *
@@ -33,9 +34,10 @@ static void batch_ctx(double *ctx, int mode, const double *x) {
  * threads share the walks one by one, however unequal their lengths (a walk that falls at once
  * and one that walks all its steps differ a hundredfold; blocks fixed in advance leave one
  * thread working alone at the end). Each row is written by the one thread that took it. */
-void amble_walk_batch(int64_t n, int64_t *next, int mode, const double *x0, const double *p, const double *opt,
-                      const int64_t *iopt_in, const double *xref, int64_t steps, int64_t check_every, double tol,
-                      int *code, int *info, int64_t *done_steps, double *dist, double *x_out) {
+void amble_walk_batch(int64_t n, int64_t *next, int mode, const double *x0, const double *p, int64_t p_stride,
+                      const double *opt, const int64_t *iopt_in, const double *xref, int64_t steps,
+                      int64_t check_every, double tol, int *code, int *info, int64_t *done_steps, double *dist,
+                      double *x_out) {
     int64_t iopt[IOPT_LEN]; /* every field: the run reads them all (IO_METHOD picks the integrator) */
     for (int i = 0; i < IOPT_LEN; ++i) iopt[i] = iopt_in[i];
     iopt[IO_OUTCAP] = iopt[IO_EVCAP] = 0;
@@ -56,7 +58,8 @@ void amble_walk_batch(int64_t n, int64_t *next, int mode, const double *x0, cons
             int64_t m = steps - walked < check_every ? steps - walked : check_every;
             batch_ctx(ctx, mode, x);
             iopt[IO_MAXSTEPS] = m;
-            st = amble_simulate(p, ctx, opt, iopt, NULL, NULL, NULL, &zero, NULL, NULL, NULL, NULL, &zero, NULL);
+            st = amble_simulate(p + r * p_stride, ctx, opt, iopt, NULL, NULL, NULL, &zero, NULL, NULL, NULL, NULL,
+                                &zero, NULL);
             int end = (int)ctx[CX_MODE];
             for (int i = 0; i < NXMAX; ++i) x[i] = i < MODE_NX[end] ? ctx[CX_X + i] : NAN;
             if (st != ST_STEPS_DONE) {
