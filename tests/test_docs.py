@@ -16,7 +16,7 @@ DOCS = ROOT / "docs"
 # Pages whose ```python blocks form one runnable script each (```py blocks are illustrative only).
 RUNNABLE = ["index.md", "guide/modeling.md", "guide/hybrid.md", "guide/simulation.md", "guide/analysis.md",
             "guide/visualisation.md", "guide/controlled-walking.md", "guide/gait-optimisation.md",
-            "guide/performance.md"]
+            "guide/performance.md", "guide/rough-terrain.md"]
 
 
 def _generator():

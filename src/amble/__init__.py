@@ -50,6 +50,7 @@ _WHERE: dict[str, str] = {
     "basin": ".analysis.basin",
     **dict.fromkeys(("hybrid_invariance_error", "invariant_parameters", "restricted_map"), ".analysis.hzd"),
     "optimize_gait": ".analysis.gait_optimisation",
+    **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
     "gait_gradients": ".analysis.gait_gradients",
     "check_gait": ".analysis.gait_check",
     "simulate": ".simulation.simulate",

@@ -8,6 +8,7 @@ from oracles.rimless_wheel_mfpt import monte_carlo_mfpt
 
 from amble import POSITIVE, Guard, Model, ParameterError, R, distance_along_slope, height_above_slope, walker
 from amble.analysis.mfpt import Terrain, mfpt
+from amble.cli.main import main
 
 ALPHA = math.pi / 8
 
@@ -61,3 +62,13 @@ def test_the_same_seed_gives_the_same_walks_and_a_steeper_spread_falls_sooner():
 def test_bad_terrains_are_refused(text, what):
     with pytest.raises(ParameterError, match=what):
         mfpt(_wheel(), Terrain.parse(text), runs=10)
+
+
+def test_the_command_line_reports_the_mfpt_and_refuses_bad_terrain(capsys):
+    import json
+
+    assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08,0.04)", "--runs", "300", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["method"] == "montecarlo" and d["ci_low"] < d["mfpt"] < d["ci_high"] and d["runs"] == 300
+    assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08)"]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
