@@ -4,6 +4,8 @@ the budget. Where the force depends on θ alone it has a potential, and the ener
 from the state (not by amble) is conserved along the whole run; with Coulomb friction added it
 never increases."""
 
+import re
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -118,8 +120,32 @@ def test_a_start_at_rest_on_a_switch_where_the_force_above_vanishes_stays_there(
     params = {"k1": 0.0, "k2": 1.0, "c": 0.0, "d": 0.0, "f": 0.0, "A": 2.0}
     tr = amble.simulate(_system(), [0.0, 0.0], params=params, t_end=5.0, options=_BUDGET)
     assert tr.status == "sliding" and tr.t[-1] == 0.0, tr.message
-    assert "theta" in tr.message and "theta_dot)" not in tr.message, tr.message
+    surface = re.search(r"switching surface \d+ \((.*)\) at t", tr.message)
+    assert surface and "theta" in surface[1] and surface[1] != "theta_dot", tr.message  # θ = d, not θ̇ = 0
     assert tr.final_state[0] == 0.0 and tr.final_state[1] == 0.0
+
+
+def test_a_start_at_rest_on_a_switch_whose_flows_both_go_up_sets_off_upwards():
+    # τ = +1 above θ = 0 (k₁ = −1), nothing below. At θ = 0 the Piecewise takes the branch below,
+    # whose flow (θ̇, −g sin θ) is at rest there but curves up just below it (g̈ = −g sin θ > 0);
+    # the flow above, (0, 1 − g sin θ), moves up: both go into θ > 0, and the run sets off upwards.
+    # (Resting at θ = 0 is a Filippov solution too — the field below vanishes there — but one
+    # that no perturbation, however small, stays on; the run used to rest there throughout.)
+    # E = ½θ̇² + g(1 − cos θ) − θ is 0, so the swing rises to the root θ_max of g(1 − cos θ) = θ
+    # and comes back after about 2π/√g = 2.0 s (the harmonic θ̈ ≈ 1 − gθ): run to 1.5 s, past the
+    # top (about π/√g = 1.0 s) and before the return
+    from scipy.optimize import brentq
+
+    g = 9.81
+    th_max = brentq(lambda th: g * (1.0 - np.cos(th)) - th, 0.1, 0.5)
+    params = {"k1": -1.0, "k2": 0.0, "c": 0.0, "d": 0.0, "f": 0.0, "A": 2.0}
+    tr = amble.simulate(_system(), [0.0, 0.0], params=params, t_end=1.5, sample_dt=1e-3, options=_BUDGET)
+    assert tr.status == "end_time", tr.message
+    th = tr.column("theta")
+    e = _energy(tr, -1.0, 0.0, 0.0)
+    assert np.max(np.abs(e)) < 1e-8, np.max(np.abs(e))
+    # the grid misses the top by ≤ ½ |θ̈| (0.5 ms)² ≈ 1.3e-7 rad (θ̈ = 1 − g sin θ_max ≈ −1 there)
+    assert th_max - 2e-7 < np.max(th) < th_max + 1e-9 and np.min(th) > -1e-9
 
 
 @pytest.mark.parametrize("thd0", [-1e-9, 1e-9, -1e-6])
