@@ -61,10 +61,10 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
  * t + h (ytmp, c = 1) — the step's error-controlled stages all on the near side, its end across by
  * no more than their difference — is seen by that last evaluation alone: its branch jumps, f
  * with it, and the dense output carries the jump times h (a pendulum resting on a switch whose
- * force vanishes on one side: a step of 0.9 s ending 1e-18 rad across, a dense output 0.1 rad
- * off mid-step, an event located there). The stage at c = 1 then stands in for it: f of the
- * near side's branch, at a state within the step's error of y, so that the crossing, seen at the
- * step's end (g_new across), is located on the near side's flow. Returns 1 if it did. */
+ * force vanishes on one side: a step of 0.9 s ending 1e-18 rad across, a dense output 1 rad off
+ * mid-step, an event located there). The stage at c = 1 then stands in for it: f of the near
+ * side's branch, at a state within the step's error of y, so that the crossing, seen at the
+ * step's end (g_new across), is located on the near side's flow. Returns 1 where it should. */
 static int near_side_end(int mode, double t, const double *ytmp, const double *p, const double *sw0,
                          const double *sw_new) {
     const int nsw = MODE_NSW[mode];
