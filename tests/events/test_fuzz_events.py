@@ -125,6 +125,16 @@ def test_a_start_at_rest_on_a_switch_where_the_force_above_vanishes_stays_there(
     assert tr.final_state[0] == 0.0 and tr.final_state[1] == 0.0
 
 
+def test_a_pendulum_hanging_at_rest_on_switches_without_force_stays_there_to_the_end():
+    # k₁ = k₂ = f = 0: the switches θ = 0 and θ̇ = 0 change no force, and the hanging pendulum is
+    # an equilibrium on both; just off them the flow rotates about it (curving back into θ̇ = 0
+    # from both sides), which must not be taken for sliding: the run lasts to its end, at rest
+    params = {"k1": 0.0, "k2": 0.0, "c": 0.0, "d": 0.0, "f": 0.0, "A": 2.0}
+    tr = amble.simulate(_system(), [0.0, 0.0], params=params, t_end=5.0, options=_BUDGET)
+    assert tr.status == "end_time", tr.message
+    assert np.all(tr.column("theta") == 0.0) and np.all(tr.column("theta_dot") == 0.0)
+
+
 def test_a_start_at_rest_on_a_switch_whose_flows_both_go_up_sets_off_upwards():
     # τ = +1 above θ = 0 (k₁ = −1), nothing below. At θ = 0 the Piecewise takes the branch below,
     # whose flow (θ̇, −g sin θ) is at rest there but curves up just below it (g̈ = −g sin θ > 0);

@@ -30,15 +30,43 @@ static double later_rate(int mode, int k, double t, const double *xs, const doub
     return 0.0;
 }
 
+/* The flow of one side of switching surface k (side: 0 for g < 0, 1 for g > 0) at x moved off it
+ * by d along coordinate ib (sgn: the sign of ∂g/∂x_ib): the state xs, the field fs there, and ġ.
+ * *tangent: ġ is zero up to the rounding of ∇g · f (grad: ∂g/∂xᵢ); *rest: the field also
+ * vanishes as d does (twice the distance, more than 1.5 times the field), the point an equilibrium
+ * of that side's flow. Returns ġ, or NAN if the right-hand side fails. */
+static double side_flow(int mode, int k, double t, const double *x, const double *p, int n, int ib, double sgn,
+                        double d, int side, const double *grad, double *xs, double *fs, int *tangent, int *rest) {
+    double gs[NTR1], x2[NXMAX], f2[NXMAX], round = 0.0, fmax1 = 0.0, fmax2 = 0.0;
+    for (int j = 0; j < n; ++j) xs[j] = x2[j] = x[j];
+    xs[ib] += (side ? 1.0 : -1.0) * sgn * d;
+    if (rhs(mode, t, xs, p, fs)) return NAN;
+    surfaces_dot(mode, t, xs, fs, p, gs);
+    for (int j = 0; j < n; ++j) round += 4.0 * DBL_EPSILON * fabs(grad[j] * fs[j]);
+    *tangent = fabs(gs[k]) <= round;
+    *rest = 0;
+    if (*tangent) {
+        x2[ib] += (side ? 2.0 : -2.0) * sgn * d;
+        if (rhs(mode, t, x2, p, f2)) return NAN;
+        for (int j = 0; j < n; ++j) { fmax1 = fmax(fmax1, fabs(fs[j])); fmax2 = fmax(fmax2, fabs(f2[j])); }
+        *rest = fmax2 > 1.5 * fmax1;
+    }
+    return gs[k];
+}
+
 /* ġ of switching surface k on both sides of it, at x moved off the surface along the coordinate
  * g depends on most (by a relative 1e-9, or twice the gap |g| to it): rate[0] on the g < 0 side,
- * rate[1] on the g > 0 side. Where the flow of a side is tangent to the surface there (ġ zero up
- * to the rounding of ∇g · f) its rate is ġ a moment later along it (later_rate: the sign of g̈).
+ * rate[1] on the g > 0 side. Where the flow of a side is tangent to the surface there (side_flow)
+ * its rate is ġ a moment later along it (later_rate: the sign of g̈) — unless both sides' flows
+ * are at rest at the point (a pendulum hanging at rest on a switch with no force to either side
+ * of it, or on one whose crossing leaves the force as it is, as θ̇ = 0 of a friction of size 0):
+ * the state is an equilibrium, the rates stay 0, and the run stays there without a decision.
  * Returns 0, or −1 if g does not depend on the state here. */
 static int side_rates(int mode, int k, double t, const double *x, const double *p, int n, double *rate,
                       double gap) {
     double e[NXMAX], gd[NTR1], grad[NXMAX], best = 0.0, sgn = 1.0;
-    int ib = -1;
+    double xs[2][NXMAX], fs[2][NXMAX];
+    int ib = -1, tangent[2], rest[2];
     for (int i = 0; i < n; ++i) {
         for (int j = 0; j < n; ++j) e[j] = i == j ? 1.0 : 0.0;
         surfaces_dot(mode, t, x, e, p, gd);
@@ -46,19 +74,15 @@ static int side_rates(int mode, int k, double t, const double *x, const double *
         if (fabs(gd[k]) > best) { best = fabs(gd[k]); ib = i; sgn = gd[k] > 0 ? 1.0 : -1.0; }
     }
     if (ib < 0) return -1;
+    const double d = fmax(1e-9 * fmax(1.0, fabs(x[ib])), 2.0 * gap / best); /* past the surface */
     for (int side = 0; side < 2; ++side) {
-        double xs[NXMAX], fs[NXMAX], gs[NTR1];
-        for (int j = 0; j < n; ++j) xs[j] = x[j];
-        double d = fmax(1e-9 * fmax(1.0, fabs(x[ib])), 2.0 * gap / best); /* past the surface */
-        xs[ib] += (side ? 1.0 : -1.0) * sgn * d;
-        rate[side] = 0.0;
-        if (rhs(mode, t, xs, p, fs)) continue;
-        surfaces_dot(mode, t, xs, fs, p, gs);
-        rate[side] = gs[k];
-        double round = 0.0;
-        for (int j = 0; j < n; ++j) round += 4.0 * DBL_EPSILON * fabs(grad[j] * fs[j]);
-        if (fabs(rate[side]) <= round) rate[side] = later_rate(mode, k, t, xs, fs, p, n, side ? 1.0 : -1.0);
+        rate[side] = side_flow(mode, k, t, x, p, n, ib, sgn, d, side, grad, xs[side], fs[side], &tangent[side],
+                               &rest[side]);
+        if (isnan(rate[side])) { rate[side] = 0.0; tangent[side] = 0; rest[side] = 1; }
     }
+    if (rest[0] && rest[1]) return 0;
+    for (int side = 0; side < 2; ++side)
+        if (tangent[side]) rate[side] = later_rate(mode, k, t, xs[side], fs[side], p, n, side ? 1.0 : -1.0);
     return 0;
 }
 
