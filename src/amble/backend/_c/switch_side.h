@@ -33,8 +33,8 @@ static double later_rate(int mode, int k, double t, const double *xs, const doub
 /* The flow of one side of switching surface k (side: 0 for g < 0, 1 for g > 0) at x moved off it
  * by d along coordinate ib (sgn: the sign of ∂g/∂x_ib): the state xs, the field fs there, and ġ.
  * *tangent: ġ is zero up to the rounding of ∇g · f (grad: ∂g/∂xᵢ); *rest: the field also
- * vanishes as d does (twice the distance, more than 1.5 times the field), the point an equilibrium
- * of that side's flow. Returns ġ, or NAN if the right-hand side fails. */
+ * vanishes as d does (twice the distance, more than 1.5 times the field, or none at all), the
+ * point an equilibrium of that side's flow. Returns ġ, or NAN if the right-hand side fails. */
 static double side_flow(int mode, int k, double t, const double *x, const double *p, int n, int ib, double sgn,
                         double d, int side, const double *grad, double *xs, double *fs, int *tangent, int *rest) {
     double gs[NTR1], x2[NXMAX], f2[NXMAX], round = 0.0, fmax1 = 0.0, fmax2 = 0.0;
@@ -49,7 +49,7 @@ static double side_flow(int mode, int k, double t, const double *x, const double
         x2[ib] += (side ? 2.0 : -2.0) * sgn * d;
         if (rhs(mode, t, x2, p, f2)) return NAN;
         for (int j = 0; j < n; ++j) { fmax1 = fmax(fmax1, fabs(fs[j])); fmax2 = fmax(fmax2, fabs(f2[j])); }
-        *rest = fmax2 > 1.5 * fmax1;
+        *rest = fmax2 > 1.5 * fmax1 || fmax2 == 0.0;
     }
     return gs[k];
 }
