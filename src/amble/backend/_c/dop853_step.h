@@ -6,9 +6,10 @@
  * are nearly all of a small model's integrator time. The runtime (runtime.c, compiled once)
  * reaches it through the hidden stepper dop853_stepper (stepper.h) inside the model's library.
  *
- * Needs from the including unit: the ST_* codes (generated from abi.py), NXMAX and
+ * Needs from the including unit: the ST_* codes (generated from abi.py), NXMAX, MODE_NTR, MODE_NSW and
  *   int rhs(int mode, double t, const double *x, const double *p, double *dx);
  *   int rhs_surfaces(int mode, double t, const double *x, const double *p, double *dx, double *g, double *gd);
+ *   and the kernels switches, guards_dot, switches_dot.
  */
 #ifndef AMBLE_DOP853_STEP_H
 #define AMBLE_DOP853_STEP_H
@@ -52,6 +53,32 @@ static double switch_crossing(int mode, double t, double h, const double *y, con
         if (th < best) best = th;
     }
     return best <= 1.0 ? best * h : -1.0;
+}
+
+/* The step's last right-hand side, f(y) at its end, is outside its error estimate (DOP_E3 and
+ * DOP_E5 vanish on it) but inside its dense output (F[2] and the stages 13–15 read it). A switching
+ * surface that passes between the end y and the state of the stage before it at the same time
+ * t + h (ytmp, c = 1) — the step's error-controlled stages all on the near side, its end across by
+ * no more than their difference — is seen by that last evaluation alone: its branch jumps, f
+ * with it, and the dense output carries the jump times h (a pendulum resting on a switch whose
+ * force vanishes on one side: a step of 0.9 s ending 1e-18 rad across, a dense output 1 rad off
+ * mid-step, an event located there). The stage at c = 1 then stands in for it: f of the near
+ * side's branch, at a state within the step's error of y, so that the crossing, seen at the
+ * step's end (g_new across), is located on the near side's flow. Returns 1 where it should. */
+static int near_side_end(int mode, double t, const double *ytmp, const double *p, const double *sw0,
+                         const double *sw_new) {
+    const int nsw = MODE_NSW[mode];
+    int across = 0;
+    /* signs compared, not products: a surface placed at ±DBL_MIN times a small g underflows */
+#define DOP_ACROSS(a, b) ((a) != 0.0 && ((b) == 0.0 || ((a) > 0.0) != ((b) > 0.0)))
+    for (int k = 0; k < nsw; ++k) across |= DOP_ACROSS(sw0[k], sw_new[k]);
+    if (!across) return 0; /* every step but those that end across a switch */
+    double g1[nsw];
+    switches(mode, t, ytmp, p, g1);
+    for (int k = 0; k < nsw; ++k)
+        if (DOP_ACROSS(sw0[k], sw_new[k]) && !DOP_ACROSS(sw0[k], g1[k])) return 1;
+#undef DOP_ACROSS
+    return 0;
 }
 
 /* The step's sums written out over the tableau's non-zero terms (the X-macro lists of
@@ -143,6 +170,11 @@ static int dop_step(Step *s, int mode, const double *p, double t_bound, double r
             if (rejected && factor > 1.0) factor = 1.0;
             *h_abs = ha * factor;
             s->h = h;
+            if (g_new && sw0 && MODE_NSW[mode] > 0 && near_side_end(mode, t + h, ytmp, p, sw0, g_new + MODE_NTR[mode])) {
+                for (int i = 0; i < n; ++i) d->K[DOP_STAGES][i] = d->K[DOP_STAGES - 1][i];
+                guards_dot(mode, t + h, s->y, d->K[DOP_STAGES], p, gd_new);
+                switches_dot(mode, t + h, s->y, d->K[DOP_STAGES], p, gd_new + MODE_NTR[mode]);
+            }
             for (int i = 0; i < n; ++i) s->f[i] = d->K[DOP_STAGES][i];
             d->dense_ready = 0;
             return 0;

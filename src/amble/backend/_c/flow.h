@@ -2,7 +2,7 @@
  * locate the earliest event inside it, record the step's rows, and move on to its end when it
  * holds no event. The transitions an event starts are transition.h's.
  *
- * Needs from the including unit: run.h, stepper.h, events.h, record.h, sensitivity.h.
+ * Needs from the including unit: run.h, stepper.h, events.h, switch_side.h, record.h, sensitivity.h.
  */
 #ifndef AMBLE_FLOW_H
 #define AMBLE_FLOW_H

@@ -6,6 +6,7 @@
  *   flow.h         integrate a step, locate its event, record its rows
  *   transition.h   cross a switching surface, or apply a reset (or end the run)
  *   events.h       guard screening and crossing location inside a step
+ *   switch_side.h  a state on a switching surface: the side the flow goes into, sliding
  *   record.h       sample and event rows in caller-owned buffers
  *   rest.h         a contact coming to rest instead of a zeno end (TR_REST)
  *   sensitivity.h  ∂x/∂(x0, p) through flows and events
@@ -36,6 +37,7 @@
 
 #include "stepper.h"
 #include "events.h"
+#include "switch_side.h"
 #include "record.h"
 #include "rest.h"
 #include "sensitivity.h"

@@ -5,7 +5,7 @@
  * The loop's pieces (flow.h, transition.h) take a Run and return −1 (the run goes on) or the
  * status ST_* that ends the call.
  *
- * Needs from the including unit: stepper.h, events.h, record.h, NSUB_MAX, the CX_, OP_, IO_ codes.
+ * Needs from the including unit: stepper.h, events.h, switch_side.h, record.h, NSUB_MAX, the CX_, OP_, IO_ codes.
  */
 #ifndef AMBLE_RUN_H
 #define AMBLE_RUN_H

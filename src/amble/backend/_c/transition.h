@@ -4,7 +4,7 @@
  * sensitivities through the saltation matrix, the guards re-armed, a contact brought to rest and
  * the counts of steps, events and Zeno clusters checked.
  *
- * Needs from the including unit: run.h, flow.h, events.h, record.h, rest.h, sensitivity.h.
+ * Needs from the including unit: run.h, flow.h, events.h, switch_side.h, record.h, rest.h, sensitivity.h.
  */
 #ifndef AMBLE_TRANSITION_H
 #define AMBLE_TRANSITION_H
