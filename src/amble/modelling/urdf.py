@@ -102,9 +102,9 @@ def _read(path: Path) -> Any:
 
 
 def _check_document(path: Path) -> None:
-    """:class:`ModelError` for a file that is not well-formed XML (a truncated file, a NUL byte)
-    or whose elements contradict each other: two links or two joints of one name, a ``<mimic>``
-    naming no joint of the file.
+    """:class:`ModelError` for a file that is not well-formed XML (a truncated file, a NUL byte),
+    is not a robot (another root element, no link, no name) or whose elements contradict each
+    other: two links or two joints of one name, a ``<mimic>`` naming no joint of the file.
 
     The parser falls back to a recovering parse when the strict one fails, which reads a file
     cut short or holding a NUL byte as if the missing or unreadable elements had never been
@@ -126,6 +126,12 @@ def _check_document(path: Path) -> None:
         line, col = e.position
         raise ModelError(f"URDF {path.name}: not well-formed XML at line {line}, column {col + 1} "
                          f"({str(e).split(':')[0]}): is the file complete?") from None
+    if root.tag != "robot":
+        raise ModelError(f"URDF {path.name}: the root element is <{root.tag}>, not <robot>")
+    if not root.findall("link"):
+        raise ModelError(f"URDF {path.name}: the <robot> declares no link (an empty description)")
+    if not root.get("name"):
+        raise ModelError(f"URDF {path.name}: the <robot> element has no name attribute, which URDF requires")
     for kind in ("link", "joint"):
         seen: set[str] = set()
         for el in root.findall(kind):
@@ -142,20 +148,37 @@ def _check_document(path: Path) -> None:
                                  "which the file does not declare")
 
 
-def _check_moments(name: str, moments: np.ndarray) -> None:
-    """The triangle inequality of a rigid body's principal moments of inertia: each at most the
-    sum of the other two (``I_x + I_y = ∫ (x² + y² + 2 z²) dm ≥ I_z``), up to a relative 1e-9 so
-    that an inertia rounded when written (a thin rod, a flat plate) still passes."""
+#: relative tolerance of the inertia checks: the rounding of numbers written to a file
+_TOL = 1e-9
+#: a length (m) below which a link's extent does not matter: ``mass · _LENGTH²`` is the scale of
+#: the inertia checks for a point mass, whose written inertia is zero or rounding (1e-35 kg m²)
+_LENGTH = 1e-3
+
+
+def _check_moments(name: str, moments: np.ndarray, scale: float) -> None:
+    """The principal moments of inertia of a rigid body: none negative and each at most the sum of
+    the other two (``I_x + I_y = ∫ (x² + y² + 2 z²) dm ≥ I_z``), both up to ``_TOL · scale`` so that
+    an inertia rounded when written (a thin rod, a flat plate, a point mass) still passes."""
+    tol = _TOL * scale
+    if moments.min() < -tol:
+        raise ModelError(f"URDF link {name!r}: inertia tensor has a negative principal moment "
+                         f"(eigenvalues {', '.join(f'{v:g}' for v in moments)}): not positive semi-definite")
     largest, total = float(moments.max()), float(moments.sum())
-    tol = 1e-9 * float(np.abs(moments).sum())
     if largest > total - largest + tol:
         raise ModelError(f"URDF link {name!r}: principal moments of inertia "
                          f"{', '.join(f'{v:g}' for v in moments)} violate the triangle inequality "
                          "(each must be at most the sum of the other two): no rigid body has them")
 
 
-def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
-    """Mass, centre of mass (link frame) and inertia about it (link axes) of a link."""
+def _check_inertial(link: Any, moves: bool = True) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass, centre of mass (link frame) and inertia about it (link axes) of a link; ``moves``:
+    False for a base fixed to the world, whose inertial enters no equation and is only checked to
+    be numbers (a file may give it a placeholder, ANYmal's ``diag(0, 0, 3e-6)`` of 1 mg).
+
+    Every physical inertia passes: positive semi-definite (a thin rod has a zero moment), a point
+    mass (zero inertia), a massless frame; eigenvalues negative by rounding only (``-2e-22`` next
+    to ``3e-6``) are accepted, relative to the larger of the tensor's own size and ``mass · (1 mm)²``.
+    The file's numbers are kept as written (Pinocchio's too: the rounding is far below that of M)."""
     ine = link.inertial
     mass = float(ine.mass) if ine.mass is not None else 0.0
     if not math.isfinite(mass):
@@ -168,11 +191,9 @@ def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
         raise ModelError(f"URDF link {link.name!r}: inertial has a non-finite number")
     if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
         raise ModelError(f"URDF link {link.name!r}: inertia tensor is not symmetric")
-    ev = np.linalg.eigvalsh(I)
-    if mass > 0 and not ev.min() > 0:
-        raise ModelError(f"URDF link {link.name!r}: inertia tensor is not positive definite "
-                         f"(eigenvalues {', '.join(f'{v:g}' for v in ev)})")
-    _check_moments(link.name, ev)
+    if moves:
+        ev = np.linalg.eigvalsh(I)
+        _check_moments(link.name, ev, max(float(np.abs(ev).sum()), mass * _LENGTH**2))
     Rc = T[:3, :3]
     return mass, T[:3, 3].copy(), Rc @ I @ Rc.T
 
@@ -229,6 +250,57 @@ def _tree_order(robot: Any, base: str | None, path: Path) -> tuple[dict[str, Any
     return links, base, order
 
 
+def _mimics(robot: Any) -> dict[str, tuple[str, float, float]]:
+    """Each moving joint with a ``<mimic>`` as ``(joint it follows, multiplier, offset)``, a chain
+    (a mimic of a mimic) resolved to the joint at its end: ``q = k₁ (k₂ q_c + c₂) + c₁``. A fixed
+    joint's ``<mimic>`` moves nothing and is dropped (a reduced file keeps the tag); a mimic of a
+    fixed joint, or a loop of mimics, is :class:`ModelError`."""
+    joints = {j.name: j for j in robot.joints}
+    direct = {j.name: j.mimic for j in robot.joints if j.mimic is not None and j.type != "fixed"}
+    out: dict[str, tuple[str, float, float]] = {}
+    for name in direct:
+        k, c, cur, seen = 1.0, 0.0, name, [name]
+        while cur in direct:
+            mm = direct[cur]
+            kk = 1.0 if mm.multiplier is None else float(mm.multiplier)
+            cc = 0.0 if mm.offset is None else float(mm.offset)
+            k, c, cur = k * kk, k * cc + c, mm.joint
+            if cur in seen:
+                raise ModelError(f"URDF joint {name!r}: <mimic> joints follow each other in a loop "
+                                 f"({' -> '.join(seen + [cur])})")
+            seen.append(cur)
+        if joints[cur].type == "fixed":
+            raise ModelError(f"URDF joint {name!r}: <mimic> follows joint {cur!r}, which is fixed")
+        out[name] = (cur, k, c)
+    return out
+
+
+def _mimic_order(order: list[tuple], mimics: Mapping[str, tuple[str, float, float]]) -> list[tuple]:
+    """``order`` (links from the base, each after its parent) with every mimic joint's link also
+    after the link of the joint it follows (whose coordinate it is made of); otherwise unchanged."""
+    placed: set[str] = set()
+    declared: set[str] = set()
+    out: list[tuple] = []
+    pending = list(order)
+    while pending:
+        rest = []
+        for item in pending:
+            lk, parent, j, _ = item
+            if (parent is None or parent in placed) and (j.name not in mimics or mimics[j.name][0] in declared):
+                out.append(item)
+                placed.add(lk)
+                declared.add(j.name)
+            else:
+                rest.append(item)
+        if len(rest) == len(pending):
+            j = next(it[2] for it in rest if it[2].name in mimics)
+            raise ModelError(f"URDF joint {j.name!r}: <mimic> follows joint {mimics[j.name][0]!r}, which only "
+                             "moves links below it (seen from the base): a mimic must follow a joint that is not "
+                             "its descendant")
+        pending = rest
+    return out
+
+
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
                 name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
                 base_joint: Joint | None = None, base_coordinate: str = "base",
@@ -249,9 +321,11 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         base_joint = dataclasses.replace(base_joint, post_xyz=tuple(-float(v) for v in spec[1]))
     robot = _read(path).robot
     links, base, order = _tree_order(robot, base, path)
-    for lk in links.values():  # every inertial is checked, the base's too (nothing is silently dropped)
+    mimics = _mimics(robot)
+    order = _mimic_order(order, mimics)
+    for lk in links.values():  # every inertial is checked before the tree is built, the base's too
         if lk.inertial is not None:
-            _check_inertial(lk)
+            _check_inertial(lk, moves=lk.name != base or base_joint is not None)
     model = cls(name or robot.name or path.stem, dims=3)
     model.gravity(gravity)
     par = _Params(model, parameters)
@@ -281,15 +355,17 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         lower = upper = None
         if j.type in ("revolute", "prismatic") and j.limit is not None:
             lower, upper = j.limit.lower, j.limit.upper
+        ref, k, c = mimics.get(j.name, (None, 1.0, 0.0))
+        tie = dict(mimic=ref, multiplier=k, offset=c)
         if forward:
             joint = Joint(j.type, axis=tuple(axis), xyz=tuple(xyz), rotation=T[:3, :3],
-                          lower=lower, upper=upper)
+                          lower=lower, upper=upper, **tie)
         else:  # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
             Rt = T[:3, :3].T
             post = [-sum((Rt[i, k] * xyz[k] for k in range(3) if Rt[i, k] != 0 and xyz[k] != 0), 0.0)
                     for i in range(3)]
             joint = Joint(j.type, axis=tuple(-axis), post_xyz=tuple(post), post_rotation=Rt,
-                          lower=lower, upper=upper)
+                          lower=lower, upper=upper, **tie)
         tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
     for pname, spec in (contact_points or {}).items():
