@@ -178,3 +178,107 @@ def test_every_shipped_urdf_loads_or_is_refused_as_the_guide_says():
         else:  # the guide quotes the message: names in `backticks` for 'quotes', <tags> escaped
             reason = html.unescape(want.removeprefix("refused: ").replace("`", "'"))
             assert got.startswith("refused: ") and reason in got, (rel, got)
+
+
+# ---------------------------------------------------------------------------- small files
+def _link(name: str, mass: float = 1.0, inertia: str = "0.02 0 0 0.03 0 0.04", com: str = "0.01 -0.02 -0.1") -> str:
+    i = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), inertia.split()))
+    attrs = " ".join(f'{k}="{v}"' for k, v in i.items())
+    return (f'<link name="{name}"><inertial><origin xyz="{com}" rpy="0.1 0.2 0.3"/><mass value="{mass}"/>'
+            f"<inertia {attrs}/></inertial></link>")
+
+
+def _joint(name: str, parent: str, child: str, kind: str = "revolute", axis: str = "0 1 0",
+           xyz: str = "0.05 0.02 -0.3", mimic: str = "") -> str:
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}" rpy="0.3 -0.2 0.1"/><axis xyz="{axis}"/>'
+            f'<limit lower="-2" upper="2" effort="1" velocity="1"/>{mimic}</joint>')
+
+
+def _robot(tmp_path: Path, *parts: str) -> Path:
+    path = tmp_path / "robot.urdf"
+    path.write_text('<robot name="r">' + "".join(parts) + "</robot>", encoding="utf-8")
+    return path
+
+
+def _mimic(joint: str, k: float = 1.0, c: float = 0.0) -> str:
+    return f'<mimic joint="{joint}" multiplier="{k}" offset="{c}"/>'
+
+
+def test_mimic_joints_match_pinocchio_projected(tmp_path):
+    """Mimics of every kind on one tree: a sibling branch listed before the joint it follows (the
+    tree is reordered), a mimic below the joint it follows (its terms meet on M's diagonal), a
+    chain (a mimic of a mimic: ``q = k₁(k₂ a + c₂) + c₁``), a prismatic joint following a
+    revolute one; multipliers and offsets other than 1 and 0. Against Pinocchio without mimics,
+    projected on the relations."""
+    path = _robot(
+        tmp_path,
+        _link("base"), _link("a"), _link("b", 0.5), _link("c", 0.3), _link("d", 0.2), _link("e", 0.7),
+        _joint("jb", "base", "b", axis="1 0 0", mimic=_mimic("ja", -0.7, 0.2)),   # before its reference
+        _joint("ja", "base", "a"),
+        _joint("jc", "a", "c", axis="0 0 1", mimic=_mimic("ja", 1.5, -0.1)),     # below its reference
+        _joint("jd", "c", "d", kind="prismatic", axis="0 0 1", mimic=_mimic("jb", 0.05, 0.01)),  # a chain
+        _joint("je", "a", "e", axis="0.6 0 0.8"),
+    )
+    model = Model.from_urdf(path)
+    assert [str(s) for s in model.q] == ["ja", "je"]
+    qd, ja = model.tree["d"].coordinate, model.symbol("ja")   # 0.05 (−0.7 ja + 0.2) + 0.01
+    assert float(qd.coeff(ja)) == pytest.approx(-0.035, rel=1e-15)
+    assert float(qd.subs(ja, 0)) == pytest.approx(0.02, rel=1e-15)
+    assert _check(path, states=20) <= 1e-12
+
+
+@pytest.mark.parametrize("parts, needle", [
+    ((_joint("ja", "base", "a", mimic=_mimic("jb")), _joint("jb", "a", "b", mimic=_mimic("ja"))),
+     "follow each other in a loop"),
+    ((_joint("ja", "base", "a", kind="fixed"), _joint("jb", "a", "b", mimic=_mimic("ja"))), "'ja', which is fixed"),
+    ((_joint("ja", "base", "a", mimic=_mimic("jb")), _joint("jb", "a", "b")), "only moves links below it"),
+], ids=["loop", "of-a-fixed-joint", "of-a-descendant"])
+def test_a_mimic_that_cannot_be_is_refused(tmp_path, parts, needle):
+    path = _robot(tmp_path, _link("base"), _link("a"), _link("b"), *parts)
+    with pytest.raises(ModelError, match=needle):
+        Model.from_urdf(path)
+
+
+def test_a_fixed_joints_mimic_is_dropped(tmp_path):
+    path = _robot(tmp_path, _link("base"), _link("a"), _link("b"), _joint("ja", "base", "a"),
+                  _joint("jb", "a", "b", kind="fixed", mimic=_mimic("ja")))
+    assert [str(s) for s in Model.from_urdf(path).q] == ["ja"]
+
+
+# the inertias of real files: Talos' sensor frames, iCub's head, a thin rod, ANYmal's base
+POINT = "0 0 0 0 0 0"
+ICUB_HEAD = "0 0 2.40741e-35 0 0 0"
+ROD = "0 0 0 1.2e-4 0 1.2e-4"
+ANYMAL_BASE = "3e-06 0 0 0 0 0"   # principal moments 3e-6, 0, 0: a placeholder no rigid body has
+ANYMAL_ROUNDED = "1.5e-06 1.5e-06 0 1.5e-06 0 0"   # eigenvalues 3e-6 and two of rounding, like the file's
+
+
+def test_physical_inertias_load_and_match_pinocchio(tmp_path):
+    """A point mass on a moving link and on a fixed sensor frame, a point mass whose written
+    inertia is rounding (1e-35 kg m²), a thin rod (one zero moment) and ANYmal's base placeholder
+    as the fixed base: all load, and the dynamics equal Pinocchio's."""
+    path = _robot(
+        tmp_path,
+        _link("base", 1e-6, ANYMAL_ROUNDED), _link("arm", 2.0, ROD), _link("hand", 1.33687, ICUB_HEAD),
+        _link("sensor", 0.01, POINT), _link("tip", 0.2, POINT),
+        _joint("j1", "base", "arm"), _joint("j2", "arm", "hand", axis="1 0 0"),
+        _joint("fix", "hand", "sensor", kind="fixed"), _joint("j3", "hand", "tip", kind="prismatic"),
+    )
+    assert [str(s) for s in Model.from_urdf(path).q] == ["j1", "j2", "j3"]
+    assert _check(path, states=20) <= 1e-12
+
+
+@pytest.mark.parametrize("inertia, mass, needle", [
+    ("-3.53e-08 0 0 3.5e-08 0 9.09e-08", 1e-6, "negative principal moment"),   # TIAGo's antenna
+    ("0.001 0 0 0.001 0 0.01", 0.1, "triangle inequality"),                     # the PR2's sensor mount
+    (ANYMAL_BASE, 1e-6, "triangle inequality"),                                 # on a link that moves
+    ("1e-20 0 0 -1e-20 0 0", 0.0, "negative principal moment"),                 # massless: no scale of mass
+    (POINT, -0.01, "negative mass"),
+], ids=["negative", "triangle", "placeholder-that-moves", "massless-negative", "negative-mass"])
+def test_an_unphysical_inertia_is_refused_naming_its_link(tmp_path, inertia, mass, needle):
+    path = _robot(tmp_path, _link("base"), _link("arm"), _link("bad", mass, inertia),
+                  _joint("j1", "base", "arm"), _joint("j2", "arm", "bad"))
+    with pytest.raises(ModelError, match=needle) as e:
+        Model.from_urdf(path)
+    assert "'bad'" in str(e.value)
