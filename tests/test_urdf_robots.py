@@ -8,7 +8,7 @@ projected onto the mimic relations read from the file here: with ``q_joints = G 
 ``M = Gᵀ M_joints G`` and ``h = Gᵀ h_joints`` — an independent reduced-coordinate computation;
 the panda is also compared with Pinocchio's own mimic joints (``mimic=True``).
 
-The last test loads every URDF the package ships and checks the outcome — loaded with so many
+The last tests load every URDF the package ships and check the outcome — loaded with so many
 coordinates, or refused for the reason given — against the list in ``docs/guide/urdf.md``.
 """
 
@@ -167,17 +167,33 @@ def _outcome(path: Path) -> str:
         return f"refused: {e}"
 
 
-def test_every_shipped_urdf_loads_or_is_refused_as_the_guide_says():
+def _shipped() -> list[str]:
+    return sorted(str(p.relative_to(ROBOTS)) for p in ROBOTS.rglob("*.urdf"))
+
+
+def test_the_guide_lists_every_shipped_urdf():
+    assert sorted(_listed()) == _shipped()
+
+
+def _cases() -> list:
+    """One case a file; a robot of more than 20 coordinates (a second or more to build its
+    tree) in the slow run."""
     listed = _listed()
-    shipped = sorted(str(p.relative_to(ROBOTS)) for p in ROBOTS.rglob("*.urdf"))
-    assert sorted(listed) == shipped
-    for rel in shipped:
-        got, want = _outcome(ROBOTS / rel), listed[rel]
-        if want.startswith("loads"):
-            assert got == want, rel
-        else:  # the guide quotes the message: names in `backticks` for 'quotes', <tags> escaped
-            reason = html.unescape(want.removeprefix("refused: ").replace("`", "'"))
-            assert got.startswith("refused: ") and reason in got, (rel, got)
+    out = []
+    for rel in _shipped():
+        n = re.match(r"loads: (\d+) coordinates", listed.get(rel, ""))
+        out.append(pytest.param(rel, marks=pytest.mark.slow) if n and int(n[1]) > 20 else rel)
+    return out
+
+
+@pytest.mark.parametrize("rel", _cases())
+def test_a_shipped_urdf_loads_or_is_refused_as_the_guide_says(rel):
+    got, want = _outcome(ROBOTS / rel), _listed()[rel]
+    if want.startswith("loads"):
+        assert got == want
+    else:  # the guide quotes the message: names in `backticks` for 'quotes', <tags> escaped
+        reason = html.unescape(want.removeprefix("refused: ").replace("`", "'"))
+        assert got.startswith("refused: ") and reason in got, got
 
 
 # ---------------------------------------------------------------------------- small files
