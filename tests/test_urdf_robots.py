@@ -298,3 +298,32 @@ def test_an_unphysical_inertia_is_refused_naming_its_link(tmp_path, inertia, mas
     with pytest.raises(ModelError, match=needle) as e:
         Model.from_urdf(path)
     assert "'bad'" in str(e.value)
+
+
+def test_massless_frames_on_fixed_joints_are_merged_into_their_body(tmp_path):
+    """Two massless frames on fixed joints (one without an inertial, one of zero mass and inertia)
+    between two moving links are no bodies: each is a point of the body it hangs from, at the
+    place of Pinocchio's frame of that name, a contact point on one is placed through it, and
+    the link below hangs through both with M, h, q̈ equal to Pinocchio's."""
+    import sympy as sp
+
+    path = _robot(
+        tmp_path,
+        _link("base"), _link("arm"), '<link name="mount"/>', _link("camera", 0.0, POINT), _link("hand", 0.4),
+        _joint("j1", "base", "arm"), _joint("f1", "arm", "mount", kind="fixed"),
+        _joint("f2", "mount", "camera", kind="fixed", xyz="0.1 0 0.02"),
+        _joint("j2", "camera", "hand", axis="1 0 0"),
+    )
+    model = Model.from_urdf(path, contact_points={"lens": ("camera", (0.01, 0.02, 0.03))})
+    assert [b.name for b in model.tree.bodies] == ["arm", "hand"]
+    assert _check(path, states=10) <= 1e-12
+    pm = pin.buildModelFromUrdf(str(path))
+    pd = pm.createData()
+    q = np.array([0.7, -0.4])
+    pin.framesForwardKinematics(pm, pd, q)  # both coordinates are revolute: q in the same order
+    assert [str(s) for s in model.q] == [pm.names[1], pm.names[2]]
+    for name, at in (("mount", (0, 0, 0)), ("camera", (0, 0, 0)), ("lens", (0.01, 0.02, 0.03))):
+        oMf = pd.oMf[pm.getFrameId("camera" if name == "lens" else name)]
+        want = oMf.translation + oMf.rotation @ np.asarray(at)
+        got = np.asarray(sp.lambdify(model.q, model.points[name])(*q), dtype=float).ravel()
+        assert np.abs(got - want).max() <= 1e-14

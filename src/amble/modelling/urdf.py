@@ -14,8 +14,17 @@ a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
   parser's own, which recovers from them silently,
 * a link reached twice (a kinematic loop, or a link with two parents),
 * a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative or
-  non-finite mass, an inertia tensor that is not finite, not symmetric, not positive definite
-  (for a link with mass), or whose principal moments break the triangle inequality.
+  non-finite mass, an inertia tensor that is not finite, not symmetric, has a clearly negative
+  principal moment, or whose principal moments break the triangle inequality — each to a relative
+  1e-9 of the larger of the tensor's size and ``mass · (1 mm)²``, so that a thin rod, a point
+  mass and rounding (``-2e-22`` next to ``3e-6``) load (:func:`_check_inertial`),
+* a ``<mimic>`` that follows a fixed joint, a joint below it, or a loop of mimics.
+
+A ``<mimic joint="a" multiplier="k" offset="c"/>`` joint has no coordinate: its angle is
+``k·a + c`` (a chain of mimics resolved), and the tree's equations are the reduced ones
+(:mod:`amble.modelling.tree`). A massless link on a fixed joint (a sensor or tool frame) is no
+body: it is a point of the body it hangs from, named as the link, and what hangs from it is placed
+through it (Pinocchio merges fixed joints the same way).
 
 The user chooses the base link, fixed to the world (e.g. the stance foot): the tree is re-rooted
 there, joints between the base and the URDF root are traversed backwards (the same joint
@@ -301,6 +310,45 @@ def _mimic_order(order: list[tuple], mimics: Mapping[str, tuple[str, float, floa
     return out
 
 
+def _joint(j: Any, forward: bool, par: _Params, mimics: Mapping[str, tuple[str, float, float]]) -> Joint:
+    """The tree joint of the URDF joint ``j`` traversed from its parent (``forward``) or back."""
+    T = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+    xyz = np.asarray(par.offset(j.name, T[:3, 3]), dtype=object)
+    axis = np.asarray(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+    lower = upper = None
+    if j.type in ("revolute", "prismatic") and j.limit is not None:
+        lower, upper = j.limit.lower, j.limit.upper
+    ref, k, c = mimics.get(j.name, (None, 1.0, 0.0))
+    tie = dict(mimic=ref, multiplier=k, offset=c)
+    if forward:
+        return Joint(j.type, axis=tuple(axis), xyz=tuple(xyz), rotation=T[:3, :3], lower=lower, upper=upper, **tie)
+    # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
+    Rt = T[:3, :3].T
+    post = [-v for v in _rotate(Rt, xyz)]
+    return Joint(j.type, axis=tuple(-axis), post_xyz=tuple(post), post_rotation=Rt, lower=lower, upper=upper, **tie)
+
+
+def _rotate(R: np.ndarray, v: Any) -> list:
+    """``R v`` for a numeric ``R`` and entries that may be parameters; exact zeros stay zeros."""
+    return [sum((R[i, k] * v[k] for k in range(3) if R[i, k] != 0 and v[k] != 0), 0.0) for i in range(3)]
+
+
+def _add(a: Any, b: Any) -> list:
+    return [x + y if x != 0 and y != 0 else (x if y == 0 else y) for x, y in zip(a, b)]
+
+
+def _rotation_of(joint: Joint) -> np.ndarray:
+    from .tree import rpy_matrix
+
+    return np.asarray(joint.rotation, dtype=float) if joint.rotation is not None else rpy_matrix(joint.rpy)
+
+
+def _massless(mass: Any, inertia: Any) -> bool:
+    """Zero mass and zero inertia, as numbers (a parameter is never zero: zeros stay numbers)."""
+    return isinstance(mass, float) and mass == 0.0 and all(
+        isinstance(v, float) and v == 0.0 for row in inertia for v in row)
+
+
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
                 name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
                 base_joint: Joint | None = None, base_coordinate: str = "base",
@@ -338,6 +386,9 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         mass, com, inertia = par.inertial(base, mass, com, inertia)
         tree.body(base, joint=base_joint, mass=mass, com=com, inertia=inertia, coordinate=base_coordinate)
         top = base
+    # a massless link on a fixed joint is a frame of the body it hangs from (as Pinocchio merges
+    # fixed joints): no body, a named point at its origin, and its children placed through it
+    frames: dict[str, tuple[str, np.ndarray, np.ndarray]] = {}   # link → (body, rotation, origin)
     for lk, parent, j, forward in order:
         parent = parent or top
         link = links[lk]
@@ -349,23 +400,19 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         else:
             mass, com, inertia = _check_inertial(link)
         mass, com, inertia = par.inertial(lk, mass, com, inertia)
-        T = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
-        xyz = np.asarray(par.offset(j.name, T[:3, 3]), dtype=object)
-        axis = np.asarray(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
-        lower = upper = None
-        if j.type in ("revolute", "prismatic") and j.limit is not None:
-            lower, upper = j.limit.lower, j.limit.upper
-        ref, k, c = mimics.get(j.name, (None, 1.0, 0.0))
-        tie = dict(mimic=ref, multiplier=k, offset=c)
-        if forward:
-            joint = Joint(j.type, axis=tuple(axis), xyz=tuple(xyz), rotation=T[:3, :3],
-                          lower=lower, upper=upper, **tie)
-        else:  # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
-            Rt = T[:3, :3].T
-            post = [-sum((Rt[i, k] * xyz[k] for k in range(3) if Rt[i, k] != 0 and xyz[k] != 0), 0.0)
-                    for i in range(3)]
-            joint = Joint(j.type, axis=tuple(-axis), post_xyz=tuple(post), post_rotation=Rt,
-                          lower=lower, upper=upper, **tie)
+        joint = _joint(j, forward, par, mimics)
+        if parent in frames:
+            parent, Rf, pf = frames[parent]
+            joint = dataclasses.replace(joint, xyz=tuple(_add(pf, _rotate(Rf, joint.xyz))),
+                                        rotation=Rf @ _rotation_of(joint))
+        if j.type == "fixed" and parent is not None and _massless(mass, inertia):
+            Rp = _rotation_of(joint)
+            origin = _add(joint.xyz, _rotate(Rp, joint.post_xyz or (0, 0, 0)))
+            post = np.eye(3) if joint.post_rotation is None else np.asarray(joint.post_rotation, dtype=float)
+            frames[lk] = (parent, Rp @ post, origin)
+            tree.point(lk, parent, origin)
+            model.link(parent, lk)
+            continue
         tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
     for pname, spec in (contact_points or {}).items():
@@ -375,5 +422,8 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             raise ModelError(f"contact point {pname!r}: give (link, (x, y, z)), got {spec!r}") from None
         if lk == base and base_joint is None:
             raise ModelError(f"contact point {pname!r} is on the base link {base!r}, which does not move")
+        if lk in frames:
+            lk, Rf, pf = frames[lk]
+            at = _add(pf, _rotate(Rf, at))
         tree.point(pname, lk, at)
     return model
