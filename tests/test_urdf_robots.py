@@ -196,6 +196,13 @@ def test_a_shipped_urdf_loads_or_is_refused_as_the_guide_says(rel):
         assert got.startswith("refused: ") and reason in got, got
 
 
+def test_human_loads_with_massless_links_by_consent():
+    """``human.urdf`` builds its ball joints from links without inertials moved by joints: refused
+    by default (listed above), loaded when they are allowed."""
+    model = Model.from_urdf(ROBOTS / "human_description/robots/human.urdf", allow_massless=True)
+    assert len(model.q) == 36
+
+
 # ---------------------------------------------------------------------------- small files
 def _link(name: str, mass: float = 1.0, inertia: str = "0.02 0 0 0.03 0 0.04", com: str = "0.01 -0.02 -0.1") -> str:
     i = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), inertia.split()))
