@@ -13,7 +13,8 @@ a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
   a ``<mimic>`` of a joint the file does not declare — found by a strict parse before the
   parser's own, which recovers from them silently,
 * a link reached twice (a kinematic loop, or a link with two parents),
-* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative or
+* a link moved by a joint without an inertial or with zero mass and inertia (unless
+  ``allow_massless=True``: a massless link with massive links below it), a negative or
   non-finite mass, an inertia tensor that is not finite, not symmetric, has a clearly negative
   principal moment, or whose principal moments break the triangle inequality — each to a relative
   1e-9 of the larger of the tensor's size and ``mass · (1 mm)²``, so that a thin rod, a point
@@ -393,12 +394,14 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         parent = parent or top
         link = links[lk]
         if link.inertial is None:
-            if j.type != "fixed" and not allow_massless:
-                raise ModelError(f"URDF link {lk!r} is moved by joint {j.name!r} but has no inertial "
-                                 "(give it one, or load with allow_massless=True)")
             mass, com, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
         else:
             mass, com, inertia = _check_inertial(link)
+        if j.type != "fixed" and not allow_massless and mass == 0.0 and not np.any(inertia):
+            # a joint moving nothing has no inertia: M is singular unless links below carry mass
+            what = "no inertial" if link.inertial is None else "an inertial of zero mass and inertia"
+            raise ModelError(f"URDF link {lk!r} is moved by joint {j.name!r} but has {what} "
+                             "(give it one, or load with allow_massless=True)")
         mass, com, inertia = par.inertial(lk, mass, com, inertia)
         joint = _joint(j, forward, par, mimics)
         if parent in frames:
