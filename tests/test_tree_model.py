@@ -116,7 +116,7 @@ CHAIN = dict(links=[("base", 1.0, (0, 0, 0)), ("l1", 1.0, (0, 0, -0.1)), ("l2", 
     (dict(joints=[CHAIN["joints"][0], ("j2", "gimbal", "l1", "l2", (0, 0, 0), (0, 1, 0))]), "'j2'"),
     (dict(joints=[CHAIN["joints"][0], ("j2", "floating", "l1", "l2", (0, 0, 0), (0, 1, 0))]), "'j2'"),
     (dict(links=CHAIN["links"][:2] + [("l2", -1.0, (0, 0, 0))]), "'l2'"),
-    (dict(inertia="ixx='0.01' iyy='-0.01' izz='0.01' ixy='0' ixz='0' iyz='0'"), "'base'"),
+    (dict(inertia="ixx='0.01' iyy='-0.01' izz='0.01' ixy='0' ixz='0' iyz='0'"), "'l1'"),  # the fixed base's is not used
 ])
 def test_bad_urdf_names_the_culprit(tmp_path, change, needle):
     spec = {**CHAIN, **change}

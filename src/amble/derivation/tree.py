@@ -13,6 +13,9 @@ sparse for axes along x, y or z. The recursions are unrolled symbolically:
   is ``F = Iᶜᵢ Sᵢ`` carried towards the root by ``F ← Xⱼᵀ F``, ``M_ij = S_jᵀ F`` on the way.
 * RNEA: ``Vᵢ = Xᵢ V_parent + Sᵢ q̇ᵢ``, ``Aᵢ = Xᵢ A_parent + Vᵢ × Sᵢ q̇ᵢ`` from ``A_base = −g``;
   ``Fᵢ = Iᵢ Aᵢ + Vᵢ ×* Iᵢ Vᵢ``, added to the parent's as ``Xᵢᵀ Fᵢ``; ``hᵢ = Sᵢᵀ Fᵢ``.
+* A mimic joint (angle ``k·a + c`` of a coordinate ``a``) has the subspace ``k Sᵢ`` per unit of
+  ``ȧ`` and adds its terms to ``a``'s row and column: the reduced ``Gᵀ M G``, ``Gᵀ h`` (``G``
+  constant, so no ``Ġ q̇`` term), without the joints' full equations.
 
 Why body frames (measured on the 7-link spatial chain, axes cycling y, x, z; full inertia
 tensors): the same recursions written in world coordinates need every body's world rotation
@@ -135,19 +138,26 @@ def tree_dynamics(tree: RigidTree | ConstrainedTree, gravity: sp.Matrix) -> tupl
     for b in reversed(bodies):
         if b.parent is not None:
             comp[b.parent.name] = comp[b.parent.name].add(comp[b.name].to_parent(X[b.name], d), d)
-    M = sp.zeros(n, n)
+    # entries (i ≤ j) as sums of terms: a mimic joint shares its coordinate with another joint, and
+    # M = Gᵀ M_joints G adds the terms of every pair of joints that coordinate moves
+    terms: dict[tuple[int, int], list[sp.Expr]] = {}
     for b in bodies:
         if not b.moving:
             continue
         F = comp[b.name].apply(S[b.name], d)
         i = b.index
-        M[i, i] = d(S[b.name].dot(F))
+        terms.setdefault((i, i), []).append(S[b.name].dot(F))
         c, a = b, b.parent
         while a is not None:
             F = X[c.name].force(F, d)
             if a.moving:
-                M[i, a.index] = M[a.index, i] = d(S[a.name].dot(F))
+                e = S[a.name].dot(F)
+                j = a.index
+                terms.setdefault((min(i, j), max(i, j)), []).append(2 * e if i == j else e)
             c, a = a, a.parent
+    M = sp.zeros(n, n)
+    for (i, j), es in terms.items():
+        M[i, j] = M[j, i] = d(sp.Add(*es))
 
     # ---- RNEA with q̈ = 0: velocities (the tree's, shared with its kinetic energy) and
     # accelerations out, forces back; gravity enters as an upward acceleration of the base
@@ -164,13 +174,16 @@ def tree_dynamics(tree: RigidTree | ConstrainedTree, gravity: sp.Matrix) -> tupl
         A[b.name] = ab
         I = inertia[b.name]
         F[b.name] = (I.apply(ab, d) + vb.cross_force(I.apply(vb, d))).named(d)
-    h = sp.zeros(n, 1)
+    hs: dict[int, list[sp.Expr]] = {}
     for b in reversed(bodies):
         f = F[b.name]
         if b.moving:
-            h[b.index] = d(S[b.name].dot(f))
+            hs.setdefault(b.index, []).append(S[b.name].dot(f))
         if b.parent is not None:
             F[b.parent.name] = (F[b.parent.name] + X[b.name].force(f, d)).named(d)
+    h = sp.zeros(n, 1)
+    for i, es in hs.items():
+        h[i] = d(sp.Add(*es))
     return M, h
 
 

@@ -51,7 +51,7 @@ def tree_impact_terms(tree: RigidTree, point: str) -> tuple[sp.Matrix, sp.Expr, 
     for b in bodies:
         if b.moving:
             F = comp[b.name].apply(_Spatial(*tree.local_subspace(b)), d)
-            ST[:, b.index] = d.vec(_matmul(b.R, F.v))
+            ST[:, b.index] = d.vec(ST[:, b.index] + _matmul(b.R, F.v))  # += : a mimic shares its column
     mt = d(sp.Add(*[comp[b.name].m for b in bodies if b.parent is None]))
     body, r = tree.point_frames[point]
     p = d.vec(body.p + r)
@@ -59,6 +59,7 @@ def tree_impact_terms(tree: RigidTree, point: str) -> tuple[sp.Matrix, sp.Expr, 
     a = body
     while a is not None:
         if a.moving:
-            Jc[:, a.index] = a.axis_w if a.joint.type == "prismatic" else d.vec(_cross(a.axis_w, p - a.axis_point))
+            col = a.axis_w if a.joint.type == "prismatic" else d.vec(_cross(a.axis_w, p - a.axis_point))
+            Jc[:, a.index] = d.vec(Jc[:, a.index] + col * a.multiplier)  # a mimic: k times, in its coordinate's column
         a = a.parent
     return ST, mt, Jc

@@ -7,6 +7,13 @@ Each :class:`Body` hangs from a parent body (or from the fixed base) by a :class
 * ``prismatic`` along a unit ``axis``,
 * ``fixed`` (no coordinate).
 
+A revolute or prismatic joint may **mimic** a coordinate of the model (``Joint(mimic="a",
+multiplier=k, offset=c)``, the URDF ``<mimic>``): its angle (or travel) is ``k·a + c`` and it has
+no coordinate of its own — a gripper's fingers driven by one motor. The tree then has one
+coordinate fewer and its equations are the reduced ones: with ``G = ∂q_joints/∂q`` (constant),
+``M = Gᵀ M_joints G`` and ``h = Gᵀ h_joints``, which the recursions produce directly because the
+joint's motion subspace per unit of ``ȧ`` is ``k`` times its own (:meth:`RigidTree.local_subspace`).
+
 A joint has an origin in its parent's frame — a translation ``xyz`` and a rotation ``rpy``
 (roll, pitch, yaw about fixed x, y, z: ``R = Rz(yaw) Ry(pitch) Rx(roll)``), the URDF conventions —
 and the joint motion follows the origin. The body has a mass, a centre of mass and a full 3×3
@@ -23,6 +30,7 @@ parents' and are never differentiated (:mod:`amble.derivation.tree` builds ``M``
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -94,7 +102,9 @@ class Joint:
 
     ``xyz``/``rpy`` (or ``rotation``, a 3×3 matrix) place the joint frame in the parent's frame;
     ``post_xyz``/``post_rotation`` an optional fixed offset after the motion (a reversed joint,
-    when a tree is re-rooted). ``lower``/``upper`` are limits (``None``: none).
+    when a tree is re-rooted). ``lower``/``upper`` are limits (``None``: none). ``mimic`` names
+    a model coordinate ``a`` that moves this joint by ``multiplier·a + offset`` (rad or m; a
+    joint with a mimic has no coordinate of its own and its limits are not the model's).
     """
 
     type: str = "revolute"
@@ -106,6 +116,9 @@ class Joint:
     post_rotation: Any = None
     lower: float | None = None
     upper: float | None = None
+    mimic: str | None = None
+    multiplier: float = 1.0
+    offset: float = 0.0
 
 
 @dataclass
@@ -118,9 +131,15 @@ class Body:
     mass: sp.Expr
     com: sp.Matrix
     inertia: sp.Matrix
-    coordinate: sp.Symbol | None = None
-    #: index of the coordinate in the model's q (None for a fixed joint)
+    #: the joint's angle or travel: a model coordinate, or ``k·a + c`` of one for a mimic joint
+    #: (None for a fixed joint)
+    coordinate: sp.Expr | None = None
+    #: index in the model's q of the coordinate that moves the joint (None for a fixed joint)
     index: int | None = None
+    #: ∂(the joint's angle)/∂q[index]: 1, or a mimic joint's multiplier
+    multiplier: sp.Expr = field(default_factory=lambda: sp.Integer(1))
+    #: the joint's rate, ``multiplier · q̇[index]`` (zero for a fixed joint)
+    rate: sp.Expr = field(default_factory=lambda: sp.Integer(0))
     R: sp.Matrix = field(default_factory=lambda: sp.eye(3))      # body → world
     p: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))  # body origin, world
     #: joint axis (world) and a point on it (world); zero axis for a fixed joint
@@ -183,6 +202,9 @@ class RigidTree:
         if joint.type not in JOINT_TYPES:
             raise ModelError(f"model {m.name!r}: joint of body {name!r} has unknown type {joint.type!r} "
                              f"(known: {', '.join(JOINT_TYPES)})")
+        if joint.mimic is not None and joint.type not in ("revolute", "continuous", "prismatic"):
+            raise ModelError(f"model {m.name!r}: joint of body {name!r} is {joint.type}: only a revolute or "
+                             "prismatic joint can mimic a coordinate")
         if joint.type in _COMPOSITE:
             cname = coordinate or name
             *inner, last = _COMPOSITE[joint.type]
@@ -222,10 +244,14 @@ class RigidTree:
             if a.shape != (3,) or na == 0.0:
                 raise ModelError(f"model {m.name!r}: joint of body {name!r} needs a nonzero 3D axis")
             joint.axis = tuple(a / na)
-            cname = coordinate or name
-            (b.coordinate,) = m.coordinates([cname], unit=unit or ("m" if joint.type == "prismatic" else "rad"))
-            b.index = m.q.index(b.coordinate)
-            self.limits[cname] = (joint.lower, joint.upper)
+            if joint.mimic is not None:
+                self._mimic(b)
+            else:
+                cname = coordinate or name
+                (b.coordinate,) = m.coordinates([cname], unit=unit or ("m" if joint.type == "prismatic" else "rad"))
+                b.index = m.q.index(b.coordinate)
+                b.rate = m.dot(b.coordinate)
+                self.limits[cname] = (joint.lower, joint.upper)
         self._kinematics(b)
         self.bodies.append(b)
         self._by_name[name] = b
@@ -243,6 +269,22 @@ class RigidTree:
         if par is not None:
             m.link(par.name, name)
         return b
+
+    def _mimic(self, b: Body) -> None:
+        """Tie a mimic joint to its model coordinate ``a``: angle ``k·a + c``, rate ``k·ȧ``."""
+        m, j = self.model, b.joint
+        ref = next((s for s in m.q if str(s) == j.mimic), None)
+        if ref is None:
+            raise ModelError(f"model {m.name!r}: joint of body {b.name!r} mimics {j.mimic!r}, which is not a "
+                             "coordinate of the model (declare the joint it follows first)")
+        k, c = float(j.multiplier), float(j.offset)
+        if not (math.isfinite(k) and math.isfinite(c)):
+            raise ModelError(f"model {m.name!r}: joint of body {b.name!r}: mimic multiplier {k:g} and offset {c:g} "
+                             "must be finite")
+        b.multiplier = _num(k)
+        b.coordinate = b.multiplier * ref + _num(c)
+        b.index = m.q.index(ref)
+        b.rate = b.multiplier * m.dot(ref)
 
     def _check_inertial(self, b: Body) -> None:
         """:class:`ModelError` naming the body for a negative or non-finite numeric mass (zero is
@@ -319,7 +361,7 @@ class RigidTree:
                 w, v = d.vec(_matmul(E.T, wp)), d.vec(_matmul(E.T, vp + _cross(wp, r)))
             sw = sv = zero
             if b.moving:
-                qd = self.model.dot(b.coordinate)
+                qd = self.model.qd[b.index]
                 a, o = self.local_subspace(b)
                 sw, sv = d.vec(a * qd), d.vec(o * qd)
                 w, v = d.vec(w + sw), d.vec(v + sv)
@@ -367,11 +409,14 @@ class RigidTree:
 
     def local_subspace(self, b: Body) -> tuple[sp.Matrix, sp.Matrix]:
         """The motion subspace of ``b``'s joint in ``b``'s own frame, ``(angular, linear at the
-        origin)`` per unit of q̇ᵢ — constant: ``(a, o × a)`` for a revolute joint about the axis
-        ``a`` through the point ``o``, ``(0, a)`` for a prismatic one."""
+        origin)`` per unit of the rate of the model coordinate ``q[b.index]`` — constant: ``(a, o × a)``
+        for a revolute joint about the axis ``a`` through the point ``o``, ``(0, a)`` for a prismatic
+        one, times the multiplier of a mimic joint."""
         j = b.joint
         Pt = _mat3(j.post_rotation).T if j.post_rotation is not None else sp.eye(3)
         a = _matmul(Pt, _vec(j.axis))
+        if b.multiplier != 1:
+            a = a * b.multiplier
         if j.type == "prismatic":
             return sp.zeros(3, 1), a
         o = -_matmul(Pt, _vec(j.post_xyz or (0, 0, 0)))   # the joint's origin, seen from the body
@@ -393,8 +438,7 @@ class RigidTree:
         else:
             a = _vec(j.axis)
             z = self.defs.vec(_matmul(Rj, a))
-            qi = b.coordinate
-            qdi = self.model.dot(qi)
+            qi, qdi = b.coordinate, b.rate
             b.axis_w, b.axis_point = z, pj
             if j.type == "prismatic":
                 R, p, w, v = Rj, pj + z * qi, w0, vj + w0.cross(z * qi) + z * qdi

@@ -13,9 +13,19 @@ a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
   a ``<mimic>`` of a joint the file does not declare — found by a strict parse before the
   parser's own, which recovers from them silently,
 * a link reached twice (a kinematic loop, or a link with two parents),
-* a link moved by a joint without an inertial (unless ``allow_massless=True``), a negative or
-  non-finite mass, an inertia tensor that is not finite, not symmetric, not positive definite
-  (for a link with mass), or whose principal moments break the triangle inequality.
+* a link moved by a joint without an inertial or with zero mass and inertia (unless
+  ``allow_massless=True``: a massless link with massive links below it), a negative or
+  non-finite mass, an inertia tensor that is not finite, not symmetric, has a clearly negative
+  principal moment, or whose principal moments break the triangle inequality — each to a relative
+  1e-9 of the larger of the tensor's size and ``mass · (1 mm)²``, so that a thin rod, a point
+  mass and rounding (``-2e-22`` next to ``3e-6``) load (:func:`_check_inertial`),
+* a ``<mimic>`` that follows a fixed joint, a joint below it, or a loop of mimics.
+
+A ``<mimic joint="a" multiplier="k" offset="c"/>`` joint has no coordinate: its angle is
+``k·a + c`` (a chain of mimics resolved), and the tree's equations are the reduced ones
+(:mod:`amble.modelling.tree`). A massless link on a fixed joint (a sensor or tool frame) is no
+body: it is a point of the body it hangs from, named as the link, and what hangs from it is placed
+through it (Pinocchio merges fixed joints the same way).
 
 The user chooses the base link, fixed to the world (e.g. the stance foot): the tree is re-rooted
 there, joints between the base and the URDF root are traversed backwards (the same joint
@@ -102,9 +112,9 @@ def _read(path: Path) -> Any:
 
 
 def _check_document(path: Path) -> None:
-    """:class:`ModelError` for a file that is not well-formed XML (a truncated file, a NUL byte)
-    or whose elements contradict each other: two links or two joints of one name, a ``<mimic>``
-    naming no joint of the file.
+    """:class:`ModelError` for a file that is not well-formed XML (a truncated file, a NUL byte),
+    is not a robot (another root element, no link, no name) or whose elements contradict each
+    other: two links or two joints of one name, a ``<mimic>`` naming no joint of the file.
 
     The parser falls back to a recovering parse when the strict one fails, which reads a file
     cut short or holding a NUL byte as if the missing or unreadable elements had never been
@@ -126,6 +136,12 @@ def _check_document(path: Path) -> None:
         line, col = e.position
         raise ModelError(f"URDF {path.name}: not well-formed XML at line {line}, column {col + 1} "
                          f"({str(e).split(':')[0]}): is the file complete?") from None
+    if root.tag != "robot":
+        raise ModelError(f"URDF {path.name}: the root element is <{root.tag}>, not <robot>")
+    if not root.findall("link"):
+        raise ModelError(f"URDF {path.name}: the <robot> declares no link (an empty description)")
+    if not root.get("name"):
+        raise ModelError(f"URDF {path.name}: the <robot> element has no name attribute, which URDF requires")
     for kind in ("link", "joint"):
         seen: set[str] = set()
         for el in root.findall(kind):
@@ -142,20 +158,37 @@ def _check_document(path: Path) -> None:
                                  "which the file does not declare")
 
 
-def _check_moments(name: str, moments: np.ndarray) -> None:
-    """The triangle inequality of a rigid body's principal moments of inertia: each at most the
-    sum of the other two (``I_x + I_y = ∫ (x² + y² + 2 z²) dm ≥ I_z``), up to a relative 1e-9 so
-    that an inertia rounded when written (a thin rod, a flat plate) still passes."""
+#: relative tolerance of the inertia checks: the rounding of numbers written to a file
+_TOL = 1e-9
+#: a length (m) below which a link's extent does not matter: ``mass · _LENGTH²`` is the scale of
+#: the inertia checks for a point mass, whose written inertia is zero or rounding (1e-35 kg m²)
+_LENGTH = 1e-3
+
+
+def _check_moments(name: str, moments: np.ndarray, scale: float) -> None:
+    """The principal moments of inertia of a rigid body: none negative and each at most the sum of
+    the other two (``I_x + I_y = ∫ (x² + y² + 2 z²) dm ≥ I_z``), both up to ``_TOL · scale`` so that
+    an inertia rounded when written (a thin rod, a flat plate, a point mass) still passes."""
+    tol = _TOL * scale
+    if moments.min() < -tol:
+        raise ModelError(f"URDF link {name!r}: inertia tensor has a negative principal moment "
+                         f"(eigenvalues {', '.join(f'{v:g}' for v in moments)}): not positive semi-definite")
     largest, total = float(moments.max()), float(moments.sum())
-    tol = 1e-9 * float(np.abs(moments).sum())
     if largest > total - largest + tol:
         raise ModelError(f"URDF link {name!r}: principal moments of inertia "
                          f"{', '.join(f'{v:g}' for v in moments)} violate the triangle inequality "
                          "(each must be at most the sum of the other two): no rigid body has them")
 
 
-def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
-    """Mass, centre of mass (link frame) and inertia about it (link axes) of a link."""
+def _check_inertial(link: Any, moves: bool = True) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass, centre of mass (link frame) and inertia about it (link axes) of a link; ``moves``:
+    False for a base fixed to the world, whose inertial enters no equation and is only checked to
+    be numbers (a file may give it a placeholder, ANYmal's ``diag(0, 0, 3e-6)`` of 1 mg).
+
+    Every physical inertia passes: positive semi-definite (a thin rod has a zero moment), a point
+    mass (zero inertia), a massless frame; eigenvalues negative by rounding only (``-2e-22`` next
+    to ``3e-6``) are accepted, relative to the larger of the tensor's own size and ``mass · (1 mm)²``.
+    The file's numbers are kept as written (Pinocchio's too: the rounding is far below that of M)."""
     ine = link.inertial
     mass = float(ine.mass) if ine.mass is not None else 0.0
     if not math.isfinite(mass):
@@ -168,11 +201,9 @@ def _check_inertial(link: Any) -> tuple[float, np.ndarray, np.ndarray]:
         raise ModelError(f"URDF link {link.name!r}: inertial has a non-finite number")
     if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
         raise ModelError(f"URDF link {link.name!r}: inertia tensor is not symmetric")
-    ev = np.linalg.eigvalsh(I)
-    if mass > 0 and not ev.min() > 0:
-        raise ModelError(f"URDF link {link.name!r}: inertia tensor is not positive definite "
-                         f"(eigenvalues {', '.join(f'{v:g}' for v in ev)})")
-    _check_moments(link.name, ev)
+    if moves:
+        ev = np.linalg.eigvalsh(I)
+        _check_moments(link.name, ev, max(float(np.abs(ev).sum()), mass * _LENGTH**2))
     Rc = T[:3, :3]
     return mass, T[:3, 3].copy(), Rc @ I @ Rc.T
 
@@ -229,6 +260,96 @@ def _tree_order(robot: Any, base: str | None, path: Path) -> tuple[dict[str, Any
     return links, base, order
 
 
+def _mimics(robot: Any) -> dict[str, tuple[str, float, float]]:
+    """Each moving joint with a ``<mimic>`` as ``(joint it follows, multiplier, offset)``, a chain
+    (a mimic of a mimic) resolved to the joint at its end: ``q = k₁ (k₂ q_c + c₂) + c₁``. A fixed
+    joint's ``<mimic>`` moves nothing and is dropped (a reduced file keeps the tag); a mimic of a
+    fixed joint, or a loop of mimics, is :class:`ModelError`."""
+    joints = {j.name: j for j in robot.joints}
+    direct = {j.name: j.mimic for j in robot.joints if j.mimic is not None and j.type != "fixed"}
+    out: dict[str, tuple[str, float, float]] = {}
+    for name in direct:
+        k, c, cur, seen = 1.0, 0.0, name, [name]
+        while cur in direct:
+            mm = direct[cur]
+            kk = 1.0 if mm.multiplier is None else float(mm.multiplier)
+            cc = 0.0 if mm.offset is None else float(mm.offset)
+            k, c, cur = k * kk, k * cc + c, mm.joint
+            if cur in seen:
+                raise ModelError(f"URDF joint {name!r}: <mimic> joints follow each other in a loop "
+                                 f"({' -> '.join(seen + [cur])})")
+            seen.append(cur)
+        if joints[cur].type == "fixed":
+            raise ModelError(f"URDF joint {name!r}: <mimic> follows joint {cur!r}, which is fixed")
+        out[name] = (cur, k, c)
+    return out
+
+
+def _mimic_order(order: list[tuple], mimics: Mapping[str, tuple[str, float, float]]) -> list[tuple]:
+    """``order`` (links from the base, each after its parent) with every mimic joint's link also
+    after the link of the joint it follows (whose coordinate it is made of); otherwise unchanged."""
+    placed: set[str] = set()
+    declared: set[str] = set()
+    out: list[tuple] = []
+    pending = list(order)
+    while pending:
+        rest = []
+        for item in pending:
+            lk, parent, j, _ = item
+            if (parent is None or parent in placed) and (j.name not in mimics or mimics[j.name][0] in declared):
+                out.append(item)
+                placed.add(lk)
+                declared.add(j.name)
+            else:
+                rest.append(item)
+        if len(rest) == len(pending):
+            j = next(it[2] for it in rest if it[2].name in mimics)
+            raise ModelError(f"URDF joint {j.name!r}: <mimic> follows joint {mimics[j.name][0]!r}, which only "
+                             "moves links below it (seen from the base): a mimic must follow a joint that is not "
+                             "its descendant")
+        pending = rest
+    return out
+
+
+def _joint(j: Any, forward: bool, par: _Params, mimics: Mapping[str, tuple[str, float, float]]) -> Joint:
+    """The tree joint of the URDF joint ``j`` traversed from its parent (``forward``) or back."""
+    T = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+    xyz = np.asarray(par.offset(j.name, T[:3, 3]), dtype=object)
+    axis = np.asarray(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+    lower = upper = None
+    if j.type in ("revolute", "prismatic") and j.limit is not None:
+        lower, upper = j.limit.lower, j.limit.upper
+    ref, k, c = mimics.get(j.name, (None, 1.0, 0.0))
+    tie = dict(mimic=ref, multiplier=k, offset=c)
+    if forward:
+        return Joint(j.type, axis=tuple(axis), xyz=tuple(xyz), rotation=T[:3, :3], lower=lower, upper=upper, **tie)
+    # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
+    Rt = T[:3, :3].T
+    post = [-v for v in _rotate(Rt, xyz)]
+    return Joint(j.type, axis=tuple(-axis), post_xyz=tuple(post), post_rotation=Rt, lower=lower, upper=upper, **tie)
+
+
+def _rotate(R: np.ndarray, v: Any) -> list:
+    """``R v`` for a numeric ``R`` and entries that may be parameters; exact zeros stay zeros."""
+    return [sum((R[i, k] * v[k] for k in range(3) if R[i, k] != 0 and v[k] != 0), 0.0) for i in range(3)]
+
+
+def _add(a: Any, b: Any) -> list:
+    return [x + y if x != 0 and y != 0 else (x if y == 0 else y) for x, y in zip(a, b)]
+
+
+def _rotation_of(joint: Joint) -> np.ndarray:
+    from .tree import rpy_matrix
+
+    return np.asarray(joint.rotation, dtype=float) if joint.rotation is not None else rpy_matrix(joint.rpy)
+
+
+def _massless(mass: Any, inertia: Any) -> bool:
+    """Zero mass and zero inertia, as numbers (a parameter is never zero: zeros stay numbers)."""
+    return isinstance(mass, float) and mass == 0.0 and all(
+        isinstance(v, float) and v == 0.0 for row in inertia for v in row)
+
+
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
                 name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
                 base_joint: Joint | None = None, base_coordinate: str = "base",
@@ -249,9 +370,11 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         base_joint = dataclasses.replace(base_joint, post_xyz=tuple(-float(v) for v in spec[1]))
     robot = _read(path).robot
     links, base, order = _tree_order(robot, base, path)
-    for lk in links.values():  # every inertial is checked, the base's too (nothing is silently dropped)
+    mimics = _mimics(robot)
+    order = _mimic_order(order, mimics)
+    for lk in links.values():  # every inertial is checked before the tree is built, the base's too
         if lk.inertial is not None:
-            _check_inertial(lk)
+            _check_inertial(lk, moves=lk.name != base or base_joint is not None)
     model = cls(name or robot.name or path.stem, dims=3)
     model.gravity(gravity)
     par = _Params(model, parameters)
@@ -264,32 +387,35 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         mass, com, inertia = par.inertial(base, mass, com, inertia)
         tree.body(base, joint=base_joint, mass=mass, com=com, inertia=inertia, coordinate=base_coordinate)
         top = base
+    # a massless link on a fixed joint is a frame of the body it hangs from (as Pinocchio merges
+    # fixed joints): no body, a named point at its origin, and its children placed through it
+    frames: dict[str, tuple[str, np.ndarray, np.ndarray]] = {}   # link → (body, rotation, origin)
     for lk, parent, j, forward in order:
         parent = parent or top
         link = links[lk]
         if link.inertial is None:
-            if j.type != "fixed" and not allow_massless:
-                raise ModelError(f"URDF link {lk!r} is moved by joint {j.name!r} but has no inertial "
-                                 "(give it one, or load with allow_massless=True)")
             mass, com, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
         else:
             mass, com, inertia = _check_inertial(link)
+        if j.type != "fixed" and not allow_massless and mass == 0.0 and not np.any(inertia):
+            # a joint moving nothing has no inertia: M is singular unless links below carry mass
+            what = "no inertial" if link.inertial is None else "an inertial of zero mass and inertia"
+            raise ModelError(f"URDF link {lk!r} is moved by joint {j.name!r} but has {what} "
+                             "(give it one, or load with allow_massless=True)")
         mass, com, inertia = par.inertial(lk, mass, com, inertia)
-        T = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
-        xyz = np.asarray(par.offset(j.name, T[:3, 3]), dtype=object)
-        axis = np.asarray(j.axis if j.axis is not None else (1.0, 0.0, 0.0), dtype=float)
-        lower = upper = None
-        if j.type in ("revolute", "prismatic") and j.limit is not None:
-            lower, upper = j.limit.lower, j.limit.upper
-        if forward:
-            joint = Joint(j.type, axis=tuple(axis), xyz=tuple(xyz), rotation=T[:3, :3],
-                          lower=lower, upper=upper)
-        else:  # traversed from child to parent: T⁻¹ = J(q)⁻¹ T_o⁻¹
-            Rt = T[:3, :3].T
-            post = [-sum((Rt[i, k] * xyz[k] for k in range(3) if Rt[i, k] != 0 and xyz[k] != 0), 0.0)
-                    for i in range(3)]
-            joint = Joint(j.type, axis=tuple(-axis), post_xyz=tuple(post), post_rotation=Rt,
-                          lower=lower, upper=upper)
+        joint = _joint(j, forward, par, mimics)
+        if parent in frames:
+            parent, Rf, pf = frames[parent]
+            joint = dataclasses.replace(joint, xyz=tuple(_add(pf, _rotate(Rf, joint.xyz))),
+                                        rotation=Rf @ _rotation_of(joint))
+        if j.type == "fixed" and parent is not None and _massless(mass, inertia):
+            Rp = _rotation_of(joint)
+            origin = _add(joint.xyz, _rotate(Rp, joint.post_xyz or (0, 0, 0)))
+            post = np.eye(3) if joint.post_rotation is None else np.asarray(joint.post_rotation, dtype=float)
+            frames[lk] = (parent, Rp @ post, origin)
+            tree.point(lk, parent, origin)
+            model.link(parent, lk)
+            continue
         tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
     for pname, spec in (contact_points or {}).items():
@@ -299,5 +425,8 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             raise ModelError(f"contact point {pname!r}: give (link, (x, y, z)), got {spec!r}") from None
         if lk == base and base_joint is None:
             raise ModelError(f"contact point {pname!r} is on the base link {base!r}, which does not move")
+        if lk in frames:
+            lk, Rf, pf = frames[lk]
+            at = _add(pf, _rotate(Rf, at))
         tree.point(pname, lk, at)
     return model
