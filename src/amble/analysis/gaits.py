@@ -106,6 +106,7 @@ def find_gaits(
     period: int = 1,
     tol: float = RESIDUAL_TOL,
     seeds: int | Sequence[Sequence[float]] = 24,
+    guesses: Sequence[Sequence[float]] = (),
     spread: float = 0.3,
     seed: int = 0,
     per_seed: int = 3,
@@ -119,7 +120,7 @@ def find_gaits(
     ``params``: parameter overrides; ``tol``: the residual ``|P_k(x) − x|∞`` of every gait
     returned; ``seeds``: the number of Halton seeds around the reference state (besides the
     reference states themselves), or the seeds as full post-impact states (``state_names``
-    order); ``spread``: half-width of the seed box relative to the reference's section
+    order); ``guesses``: states tried first, in addition to the seeds; ``spread``: half-width of the seed box relative to the reference's section
     coordinates; ``seed``: the seed of the Halton set's shift; ``per_seed``: gaits a seed may yield in
     turn; ``max_iter``: Newton iterations of one run; ``rtol``, ``atol``: integrator tolerances;
     ``progress``: a progress bar (default: on a terminal only).
@@ -132,7 +133,8 @@ def find_gaits(
     P1 = ReturnMap(system, params, period=1, rtol=rtol, atol=atol)
     names = list(P1.k.meta["params"])
     values = dict(zip(names, P1.p.tolist()))
-    starts = _seeds(system, P1, values, seeds, spread, seed)
+    starts = [initial_state(system, P1.k, x, P1.mode)[1] for x in guesses]
+    starts += _seeds(system, P1, values, seeds, spread, seed)
     out = Gaits(system=system.name, parameters=values, max_period=period, seeds=len(starts))
     from tqdm.auto import tqdm
 
@@ -277,12 +279,12 @@ _PRIMES = (2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 6
            103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181, 191, 193, 197, 199)
 
 
-def halton(n: int, d: int, seed: int = 0) -> np.ndarray:
+def halton(n: int, d: int, seed: int | None = 0) -> np.ndarray:
     """``n`` points of the Halton sequence in ``[0, 1)^d`` (radical inverses in the first ``d``
     primes, from index 1), each coordinate rotated by a uniform shift drawn from ``seed``
-    (Cranley–Patterson, modulo 1): low-discrepancy, reproducible. For d above 46 the bases repeat
-    with a different shift (the points are then merely a seeded set)."""
-    shift = np.random.default_rng(seed).random(d)
+    (Cranley–Patterson, modulo 1; ``None``: no shift): low-discrepancy, reproducible. For d above
+    46 the bases repeat (with a shift, the points are then merely a seeded set)."""
+    shift = np.random.default_rng(seed).random(d) if seed is not None else np.zeros(d)
     out = np.empty((n, d))
     for j in range(d):
         base = _PRIMES[j % len(_PRIMES)]

@@ -23,6 +23,8 @@ from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
 from .args import UsageError, _float, _Parser, load_model, parse_sets, robot_options, writable_path
 from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
+from .gaits import EXAMPLE as GAITS_EXAMPLE
+from .gaits import add_parser as add_gaits_parser
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
 from .output import write_output
@@ -226,6 +228,7 @@ EXAMPLES = {
     "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
     "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
     "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
+    "gaits": GAITS_EXAMPLE,
     "mfpt": MFPT_EXAMPLE,
     "cache": "amble cache clear --older-than 30 --dry-run",
 }
@@ -359,6 +362,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
 
     add_gait_parser(add, model_arg)
+    add_gaits_parser(add, model_arg)
     add_mfpt_parser(add, model_arg)
     add_cache_parser(add)
     return p
