@@ -120,9 +120,10 @@ def find_gaits(
     ``params``: parameter overrides; ``tol``: the residual ``|P_k(x) − x|∞`` of every gait
     returned; ``seeds``: the number of Halton seeds around the reference state (besides the
     reference states themselves), or the seeds as full post-impact states (``state_names``
-    order); ``guesses``: states tried first, in addition to the seeds; ``spread``: half-width of the seed box relative to the reference's section
-    coordinates; ``seed``: the seed of the Halton set's shift; ``per_seed``: gaits a seed may yield in
-    turn; ``max_iter``: Newton iterations of one run; ``rtol``, ``atol``: integrator tolerances;
+    order); ``guesses``: states tried first, in addition to the seeds; ``spread``: half-width of
+    the seed box relative to the reference's section coordinates; ``seed``: the seed of the
+    Halton set's shift; ``per_seed``: gaits a seed may yield in turn; ``max_iter``: Newton
+    iterations of one run; ``rtol``, ``atol``: integrator tolerances;
     ``progress``: a progress bar (default: on a terminal only).
     """
     if not 1 <= period <= MAX_PERIOD:
