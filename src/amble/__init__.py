@@ -49,6 +49,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("cascade", "continue_branch", "switch_at_flip"), ".analysis.continuation"),
     "basin": ".analysis.basin",
     "find_gaits": ".analysis.gaits",
+    "period_doublings": ".analysis.doublings",
     **dict.fromkeys(("hybrid_invariance_error", "invariant_parameters", "restricted_map"), ".analysis.hzd"),
     "optimize_gait": ".analysis.gait_optimisation",
     **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
