@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 import ctypes
+import operator
 import threading
 import weakref
 from pathlib import Path
@@ -18,7 +19,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..errors import CompileError, ModelError, StateError
+from ..errors import CompileError, ModelError, ParameterError, StateError
 from . import abi, cache
 from .cache import cache_dir, structure_key
 
@@ -144,21 +145,18 @@ class Kernels:
         # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
         # evaluation, and building typed ctypes pointers costs more than a walking step.
         lib.amble_simulate.argtypes = [ctypes.c_void_p] * 14
-        lib.amble_rhs.restype = ctypes.c_int
-        lib.amble_rhs.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_guards.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_reset.restype = ctypes.c_int
-        lib.amble_reset.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _iptr]
-        lib.amble_dynamics.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr, _dptr]
+        # The per-state entry points take raw addresses (void *): typed ctypes pointers built per call
+        # (ndarray.ctypes.data_as) cost several times the call itself.
+        ptrs = lambda n: [ctypes.c_void_p] * n  # noqa: E731
+        for name, res, args in (("amble_rhs", ctypes.c_int, ptrs(3)), ("amble_guards", None, ptrs(3)),
+                                ("amble_reset", ctypes.c_int, ptrs(4)), ("amble_dynamics", None, ptrs(5)),
+                                ("amble_rhs_jac", ctypes.c_int, ptrs(4)), ("amble_rhs_jacp", ctypes.c_int, ptrs(3)),
+                                ("amble_surfaces_grad", None, ptrs(3)), ("amble_reset_jac", ctypes.c_int, ptrs(3))):
+            f = getattr(lib, name)
+            f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *args]
         lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
-        lib.amble_rhs_jac.restype = ctypes.c_int
-        lib.amble_rhs_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr]
-        lib.amble_rhs_jacp.restype = ctypes.c_int
-        lib.amble_rhs_jacp.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_surfaces_grad.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_reset_jac.restype = ctypes.c_int
-        lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
+        self._fast_tables()
         self.simulate_raw = lib.amble_simulate
         lib.amble_walk_batch.restype = None
         lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 2 + \
@@ -172,56 +170,106 @@ class Kernels:
                                             ctypes.c_void_p, ctypes.c_void_p]
         self._project_batch = lib.amble_project_batch
 
-    # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
+    # -- single states (analysis, tests, a user's own loop); the hot path is amble_simulate.
+    # Inputs: any array-like; a float64 C-contiguous writable ndarray of the right shape is handed
+    # to C as it is (its address), anything else is converted first. Shapes are checked before any
+    # address reaches C. Every call returns fresh arrays (nothing is reused between calls).
+    def _fast_tables(self) -> None:
+        """What the per-state calls look up, worked out once: mode and transition indices by
+        name, state lengths, rows of guards and surfaces per mode, the entry points."""
+        meta, lib = self.meta, self._lib
+        modes, trs = meta["modes"], meta["transitions"]
+        self._mode_ix = {m: i for i, m in enumerate(modes)}
+        self._tr_ix = {tr["name"]: i for i, tr in enumerate(trs)}
+        self._nx = tuple(meta["nx"])
+        self._npar = len(meta["params"])
+        self._n_guards = tuple(sum(tr["source"] == m for tr in trs) for m in modes)
+        self._n_surfaces = tuple(g + sum(sw["mode"] == m for sw in meta["switches"])
+                                 for m, g in zip(modes, self._n_guards))
+        self._tr_nx = tuple((self._nx[modes.index(tr["source"])],
+                             self._nx[modes.index(tr["target"])] if tr["target"] else
+                             self._nx[modes.index(tr["source"])]) for tr in trs)
+        self._p_seen: tuple[Any, int] = (None, 0)
+        self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
+        self._c_dynamics, self._c_rhs_jac, self._c_rhs_jacp = lib.amble_dynamics, lib.amble_rhs_jac, lib.amble_rhs_jacp
+        self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
+
     def mode_index(self, mode: str | int) -> int:
-        if isinstance(mode, int):
+        """The index of a mode given by name or index (:class:`~amble.errors.ModelError` if none)."""
+        if type(mode) is int and 0 <= mode < self.n_modes:
             return mode
-        try:
-            return self.meta["modes"].index(mode)
-        except ValueError:
-            raise ModelError(f"unknown mode {mode!r}; modes: {', '.join(self.meta['modes'])}") from None
+        i = self._mode_ix.get(mode) if isinstance(mode, str) else _index(mode, self.n_modes)
+        if i is None:
+            raise ModelError(f"unknown mode {mode!r}; modes: {', '.join(self.meta['modes'])} "
+                             f"(or their indices 0 … {self.n_modes - 1})")
+        return i
+
+    def transition_index(self, transition: str | int) -> int:
+        """The index of a transition given by name or index (:class:`~amble.errors.ModelError` if none)."""
+        if type(transition) is int and 0 <= transition < self.n_tr:
+            return transition
+        i = self._tr_ix.get(transition) if isinstance(transition, str) else _index(transition, self.n_tr)
+        if i is None:
+            raise ModelError(f"unknown transition {transition!r}; transitions: {', '.join(self._tr_ix)} "
+                             f"(or their indices 0 … {self.n_tr - 1})")
+        return i
+
+    def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int]:
+        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), and the
+        state's array (alive until the call returns). The last parameter array seen is kept with
+        its address: a caller passes the same one call after call, and holding it keeps its memory
+        where it is (NumPy refuses to resize an array that is referenced)."""
+        ax, x = _arg(x, nx, StateError, "state")
+        seen = self._p_seen
+        if p is not seen[0] or p.dtype is not _F64:
+            if self._npar == 0 and np.size(p) <= 1:  # no parameters: any placeholder of ≤ 1 entry
+                p = _NO_PARAMS
+            ap, p = _arg(p, self._npar or 1, ParameterError, "parameter vector")
+            self._p_seen = (p, ap)
+            return ax, x, ap
+        return ax, x, seen[1]
 
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = self.mode_index(mode)
-        x = _vec(x, self.meta["nx"][mi])
-        dx = np.zeros_like(x)
-        err = self._lib.amble_rhs(mi, float(t), _p(x), _p(p), _p(dx))
-        if err:
+        nx = self._nx[mi]
+        ax, x, ap = self._xp(nx, x, p)
+        buf = _out(nx)
+        if self._c_rhs(mi, float(t), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        return dx
+        return _frombuffer(buf)
 
     def dynamics(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = self.mode_index(mode)
-        nx = self.meta["nx"][mi]
-        x = _vec(x, nx)
+        nx = self._nx[mi]
         n = nx // 2
-        M, h, G = np.zeros((n, n)), np.zeros(n), np.zeros(n)
-        self._lib.amble_dynamics(mi, float(t), _p(x), _p(p), _p(M), _p(h), _p(G))
-        return M, h, G
+        ax, x, ap = self._xp(nx, x, p)
+        buf = _out(n * n + 2 * n)
+        a0 = _addressof(buf)
+        self._c_dynamics(mi, float(t), ax, ap, a0, a0 + 8 * n * n, a0 + 8 * (n * n + n))
+        out = _frombuffer(buf)
+        return out[: n * n].reshape(n, n), out[n * n : n * n + n], out[n * n + n :]
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """The guard values of the transitions from a mode, in order."""
         mi = self.mode_index(mode)
-        x = _vec(x, self.meta["nx"][mi])
-        g = np.zeros(max(self.n_tr, 1))
-        self._lib.amble_guards(mi, float(t), _p(x), _p(p), _p(g))
-        n = sum(1 for tr in self.meta["transitions"] if tr["source"] == self.meta["modes"][mi])
-        return g[:n]
+        ax, x, ap = self._xp(self._nx[mi], x, p)
+        buf = _out(max(self.n_tr, 1))
+        self._c_guards(mi, float(t), ax, ap, buf)
+        return _frombuffer(buf)[: self._n_guards[mi]]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
-        trs = self.meta["transitions"]
-        k = transition if isinstance(transition, int) else [tr["name"] for tr in trs].index(transition)
-        src = self.meta["modes"].index(trs[k]["source"])
-        x = _vec(x, self.meta["nx"][src])
-        out = np.zeros(self.nx_max)
-        target = ctypes.c_int(-1)
-        err = self._lib.amble_reset(k, float(t), _p(x), _p(p), _p(out), ctypes.byref(target))
-        if err:
-            raise ModelError(f"reset of {trs[k]['name']!r} failed (singular impulse system)")
-        mode = self.meta["modes"][target.value]
-        return mode, out[: self.meta["nx"][target.value]].copy()
+        k = self.transition_index(transition)
+        ax, x, ap = self._xp(self._tr_nx[k][0], x, p)
+        buf = _out(self.nx_max + 1)  # the post state, then the target's index (an int in the last slot)
+        a0 = _addressof(buf)
+        if self._c_reset(k, float(t), ax, ap, a0, a0 + 8 * self.nx_max):
+            raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
+        target = ctypes.c_int.from_buffer(buf, 8 * self.nx_max).value
+        return self.meta["modes"][target], _frombuffer(buf)[: self._nx[target]]
 
     # -- exact derivatives (generated from the symbolic model; see backend/variational_codegen.py)
     def _need_derivatives(self) -> None:
@@ -234,15 +282,16 @@ class Kernels:
         """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
         self._need_derivatives()
         mi = self.mode_index(mode)
-        nx = self.meta["nx"][mi]
-        x = _vec(x, nx)
-        dx, J = np.zeros(nx), np.zeros((nx, self.sc))
-        err = self._lib.amble_rhs_jac(mi, float(t), _p(x), _p(p), _p(dx), _p(J))
-        err = err or self._lib.amble_rhs_jacp(mi, float(t), _p(x), _p(p), _p(J))
-        if err:
+        nx = self._nx[mi]
+        ax, x, ap = self._xp(nx, x, p)
+        buf = _out(nx + nx * self.sc)  # f, then the rows of [∂f/∂x, ∂f/∂p] of sc columns
+        a0 = _addressof(buf)
+        t = float(t)
+        if self._c_rhs_jac(mi, t, ax, ap, a0, a0 + 8 * nx) or self._c_rhs_jacp(mi, t, ax, ap, a0 + 8 * nx):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        npar = len(self.meta["params"])
-        return dx, J[:, :nx].copy(), J[:, self.nx_max : self.nx_max + npar].copy()
+        out = _frombuffer(buf)
+        J = out[nx:].reshape(nx, self.sc)
+        return out[:nx], J[:, :nx].copy(), J[:, self.nx_max : self.nx_max + self._npar].copy()
 
     def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray]:
@@ -250,30 +299,26 @@ class Kernels:
         its switching surfaces."""
         self._need_derivatives()
         mi = self.mode_index(mode)
-        nx = self.meta["nx"][mi]
-        x = _vec(x, nx)
-        G = np.zeros((max(self.n_tr, 1) + len(self.meta["switches"]), self.sc))
-        self._lib.amble_surfaces_grad(mi, float(t), _p(x), _p(p), _p(G))
-        rows = sum(1 for tr in self.meta["transitions"] if tr["source"] == self.meta["modes"][mi])
-        rows += sum(1 for sw in self.meta["switches"] if sw["mode"] == self.meta["modes"][mi])
-        npar = len(self.meta["params"])
-        return G[:rows, :nx].copy(), G[:rows, self.nx_max : self.nx_max + npar].copy()
+        nx = self._nx[mi]
+        ax, x, ap = self._xp(nx, x, p)
+        buf = _out((max(self.n_tr, 1) + len(self.meta["switches"])) * self.sc)
+        self._c_surfaces_grad(mi, float(t), ax, ap, buf)
+        rows = self._n_surfaces[mi]
+        G = _frombuffer(buf)[: rows * self.sc].reshape(rows, self.sc)
+        return G[:, :nx].copy(), G[:, self.nx_max : self.nx_max + self._npar].copy()
 
-    def reset_jacobian(self, transition: int, t: float, x: np.ndarray, p: np.ndarray
+    def reset_jacobian(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
         self._need_derivatives()
-        trs = self.meta["transitions"]
-        src = self.meta["modes"].index(trs[transition]["source"])
-        dst = self.meta["modes"].index(trs[transition]["target"]) if trs[transition]["target"] else src
-        nx, nd = self.meta["nx"][src], self.meta["nx"][dst]
-        x = _vec(x, nx)
-        D = np.zeros((self.nx_max, self.sc + 1))
-        err = self._lib.amble_reset_jac(transition, float(t), _p(x), _p(p), _p(D))
-        if err:
-            raise ModelError(f"reset of {trs[transition]['name']!r} failed (singular impulse system)")
-        npar = len(self.meta["params"])
-        return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + npar].copy(), D[:nd, self.sc].copy()
+        k = self.transition_index(transition)
+        nx, nd = self._tr_nx[k]
+        ax, x, ap = self._xp(nx, x, p)
+        buf = _out(self.nx_max * (self.sc + 1))
+        if self._c_reset_jac(k, float(t), ax, ap, buf):
+            raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
+        D = _frombuffer(buf).reshape(self.nx_max, self.sc + 1)
+        return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + self._npar].copy(), D[:nd, self.sc].copy()
 
     def walk_batch(self, mode: str | int, x0: np.ndarray, p: np.ndarray, opt: np.ndarray, iopt: np.ndarray,
                    xref: np.ndarray, steps: int, check_every: int, tol: float, threads: int = 1
@@ -378,10 +423,57 @@ def _p(a: np.ndarray) -> Any:
     return a.ctypes.data_as(_dptr)
 
 
+_F64 = np.dtype(np.float64)
+_addressof = ctypes.addressof
+_bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1 byte, else an error
+_frombuffer = np.frombuffer
+_OUT: dict[int, type] = {}
+_NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
+
+
+def _out(n: int) -> ctypes.Array:
+    """A fresh zeroed C array of ``n`` doubles: the output of one call, handed to C as it is and
+    returned as an ndarray over the same memory (cheaper than an ndarray's address)."""
+    t = _OUT.get(n)
+    if t is None:
+        t = _OUT[n] = ctypes.c_double * max(n, 1)
+    return t()
+
+
+def _index(i: Any, n: int) -> int | None:
+    """An integer index in ``0 … n − 1`` (a NumPy integer too), else ``None``."""
+    if isinstance(i, bool):
+        return None
+    try:
+        i = operator.index(i)
+    except TypeError:
+        return None
+    return i if 0 <= i < n else None
+
+
+def _arg(a: Any, n: int, error: type[Exception], what: str) -> tuple[int, np.ndarray]:
+    """The address of ``a`` as ``n`` float64 entries in a row, and the array at that address (it
+    must be kept alive until the call returns). A float64 C-contiguous writable ndarray of shape
+    ``(n,)`` is passed as it is; anything else of ``n`` entries is converted; another size raises
+    ``error`` — before any address reaches C."""
+    if type(a) is np.ndarray and a.dtype is _F64 and a.shape == (n,):
+        try:
+            return _addressof(_bytes_of(a)), a
+        except (TypeError, ValueError, BufferError):  # read-only, not contiguous, or empty
+            pass
+    try:
+        a = np.ascontiguousarray(a, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise error(f"{what} must be {n} real numbers, got {a!r}") from None
+    if a.shape != (n,):
+        raise error(f"{what} has {a.size} entries, expected {n}")
+    return a.ctypes.data, a
+
+
 def _vec(x: Any, n: int) -> np.ndarray:
     x = np.ascontiguousarray(x, dtype=float).ravel()
     if x.shape != (n,):
-        raise ModelError(f"state has {x.size} entries, expected {n}")
+        raise StateError(f"state has {x.size} entries, expected {n}")
     return x
 
 
