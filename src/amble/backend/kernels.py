@@ -156,6 +156,10 @@ class Kernels:
             f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *args]
         lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
+        lib.amble_rows.restype = ctypes.c_int64
+        lib.amble_rows.argtypes = [ctypes.c_int64, ctypes.c_int, ctypes.c_int, ctypes.c_void_p, ctypes.c_int64,
+                                   ctypes.c_void_p, ctypes.c_int64, ctypes.c_void_p, ctypes.c_int64,
+                                   ctypes.c_void_p, ctypes.c_int64]
         self._fast_tables()
         self.simulate_raw = lib.amble_simulate
         lib.amble_walk_batch.restype = None
@@ -320,6 +324,59 @@ class Kernels:
         D = _frombuffer(buf).reshape(self.nx_max, self.sc + 1)
         return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + self._npar].copy(), D[:nd, self.sc].copy()
 
+    # -- many states per call: one compiled loop over the rows (amble_rows; the GIL is released)
+    def _many(self, op: str, mode: str | int, t: Any, X: Any, p: Any, width: int) -> np.ndarray:
+        """Operation ``op`` (:data:`amble.backend.abi.ROW_OPS`) of ``mode`` at every row of ``X``;
+        ``width`` output entries per row. ``t``: one time or one per row; ``p``: one parameter
+        vector or one row per state."""
+        mi = self.mode_index(mode)
+        nx = self._nx[mi]
+        X = _matrix(X, nx, StateError, "states")
+        n = X.shape[0]
+        try:
+            t = np.asarray(t, dtype=np.float64)
+            P = np.ascontiguousarray(p if self._npar or np.size(p) > 1 else _NO_PARAMS, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise StateError("times and parameters must be real numbers") from None
+        if t.ndim > 1 or (t.ndim == 1 and t.shape != (n,)):
+            raise StateError(f"times must be one number or one per state ({n}), got shape {t.shape}")
+        t, ts = np.ascontiguousarray(t), t.ndim  # a 0-d time becomes one entry read by every row
+        npar = self._npar or 1
+        if P.shape != (npar,) and P.shape != (n, npar):
+            raise ParameterError(f"parameters must be one vector of {self._npar} or one row of {self._npar} "
+                                 f"per state, got shape {P.shape}")
+        out = np.zeros((n, width))
+        bad = self._lib.amble_rows(n, abi.ROW_OP[op], mi, t.ctypes.data, ts, X.ctypes.data, nx, P.ctypes.data,
+                                   npar if P.ndim == 2 else 0, out.ctypes.data, width)
+        if bad >= 0:
+            raise ModelError(f"mass matrix is singular or ill-conditioned at state {X[bad].tolist()} (row {bad})")
+        return out
+
+    def rhs_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """:meth:`rhs` at every row of ``X`` (``n × nx``) in one compiled call: ``n × nx``.
+        ``t``: one time or one per row; ``p``: one parameter vector or one row per state. Each
+        row equals :meth:`rhs` of that row, bit for bit."""
+        return self._many("RHS", mode, t, X, p, self._nx[self.mode_index(mode)])
+
+    def dynamics_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`dynamics` at every row of ``X`` in one compiled call: ``M`` (``n × nq × nq``),
+        ``h`` and ``Γ`` (``n × nq``), ``nq = nx / 2``. ``t``, ``p`` as for :meth:`rhs_many`."""
+        nq = self._nx[self.mode_index(mode)] // 2
+        out = self._many("DYNAMICS", mode, t, X, p, nq * nq + 2 * nq)
+        return out[:, : nq * nq].reshape(-1, nq, nq), out[:, nq * nq : nq * nq + nq], out[:, nq * nq + nq :]
+
+    def rhs_jacobian_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`rhs_jacobian` at every row of ``X`` in one compiled call: ``f`` (``n × nx``),
+        ``∂f/∂x`` (``n × nx × nx``), ``∂f/∂p`` (``n × nx × len(params)``). ``t``, ``p`` as for
+        :meth:`rhs_many`."""
+        self._need_derivatives()
+        nx = self._nx[self.mode_index(mode)]
+        out = self._many("RHS_JAC", mode, t, X, p, nx + nx * self.sc)
+        J = out[:, nx:].reshape(-1, nx, self.sc)
+        return out[:, :nx], J[:, :, :nx].copy(), J[:, :, self.nx_max : self.nx_max + self._npar].copy()
+
     def walk_batch(self, mode: str | int, x0: np.ndarray, p: np.ndarray, opt: np.ndarray, iopt: np.ndarray,
                    xref: np.ndarray, steps: int, check_every: int, tol: float, threads: int = 1
                    ) -> dict[str, np.ndarray]:
@@ -468,6 +525,19 @@ def _arg(a: Any, n: int, error: type[Exception], what: str) -> tuple[int, np.nda
     if a.shape != (n,):
         raise error(f"{what} has {a.size} entries, expected {n}")
     return a.ctypes.data, a
+
+
+def _matrix(a: Any, n: int, error: type[Exception], what: str) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array of rows of ``n`` entries (one row: a vector)."""
+    try:
+        a = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise error(f"{what} must be rows of {n} real numbers") from None
+    if a.ndim == 1 and a.shape == (n,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != n:
+        raise error(f"{what} must be rows of {n} entries, got shape {a.shape}")
+    return a
 
 
 def _vec(x: Any, n: int) -> np.ndarray:
