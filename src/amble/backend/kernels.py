@@ -151,6 +151,7 @@ class Kernels:
         for name, res, args in (("amble_rhs", ctypes.c_int, ptrs(3)), ("amble_guards", None, ptrs(3)),
                                 ("amble_reset", ctypes.c_int, ptrs(4)), ("amble_dynamics", None, ptrs(5)),
                                 ("amble_rhs_jac", ctypes.c_int, ptrs(4)), ("amble_rhs_jacp", ctypes.c_int, ptrs(3)),
+                                ("amble_rhs_jac_all", ctypes.c_int, ptrs(4)),
                                 ("amble_surfaces_grad", None, ptrs(3)), ("amble_reset_jac", ctypes.c_int, ptrs(3))):
             f = getattr(lib, name)
             f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *args]
@@ -194,8 +195,9 @@ class Kernels:
                              self._nx[modes.index(tr["target"])] if tr["target"] else
                              self._nx[modes.index(tr["source"])]) for tr in trs)
         self._p_seen: tuple[Any, int] = (None, 0)
+        self._derivatives = bool(meta.get("derivatives"))
         self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
-        self._c_dynamics, self._c_rhs_jac, self._c_rhs_jacp = lib.amble_dynamics, lib.amble_rhs_jac, lib.amble_rhs_jacp
+        self._c_dynamics, self._c_rhs_jac_all = lib.amble_dynamics, lib.amble_rhs_jac_all
         self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
 
     def mode_index(self, mode: str | int) -> int:
@@ -218,26 +220,30 @@ class Kernels:
                              f"(or their indices 0 … {self.n_tr - 1})")
         return i
 
-    def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int]:
-        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), and the
-        state's array (alive until the call returns). The last parameter array seen is kept with
-        its address: a caller passes the same one call after call, and holding it keeps its memory
-        where it is (NumPy refuses to resize an array that is referenced)."""
+    def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
+        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
+        the arrays at them (to keep alive until the call returns). The caller's last parameter
+        array is remembered with its address: it is passed call after call, and holding it keeps
+        its memory where it is (NumPy refuses to resize an array that is referenced)."""
         ax, x = _arg(x, nx, StateError, "state")
         seen = self._p_seen
-        if p is not seen[0] or p.dtype is not _F64:
-            if self._npar == 0 and np.size(p) <= 1:  # no parameters: any placeholder of ≤ 1 entry
-                p = _NO_PARAMS
-            ap, p = _arg(p, self._npar or 1, ParameterError, "parameter vector")
+        if p is seen[0] and p.dtype is _F64:
+            return ax, x, seen[1], p
+        if self._npar == 0:  # no parameters: any placeholder of ≤ 1 entry (C reads none of it)
+            if np.size(p) > 1:
+                raise ParameterError(f"system {self.meta['name']!r} has no parameters, got {np.size(p)} values")
+            q, ap = _NO_PARAMS, _NO_PARAMS_ADDRESS
+        else:
+            ap, q = _arg(p, self._npar, ParameterError, "parameter vector")
+        if type(p) is np.ndarray and (q is p or self._npar == 0):  # only the caller's own array is remembered
             self._p_seen = (p, ap)
-            return ax, x, ap
-        return ax, x, seen[1]
+        return ax, x, ap, q
 
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = self.mode_index(mode)
         nx = self._nx[mi]
-        ax, x, ap = self._xp(nx, x, p)
+        ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(nx)
         if self._c_rhs(mi, float(t), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
@@ -249,7 +255,7 @@ class Kernels:
         mi = self.mode_index(mode)
         nx = self._nx[mi]
         n = nx // 2
-        ax, x, ap = self._xp(nx, x, p)
+        ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(n * n + 2 * n)
         a0 = _addressof(buf)
         self._c_dynamics(mi, float(t), ax, ap, a0, a0 + 8 * n * n, a0 + 8 * (n * n + n))
@@ -259,7 +265,7 @@ class Kernels:
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The guard values of the transitions from a mode, in order."""
         mi = self.mode_index(mode)
-        ax, x, ap = self._xp(self._nx[mi], x, p)
+        ax, x, ap, p = self._xp(self._nx[mi], x, p)
         buf = _out(max(self.n_tr, 1))
         self._c_guards(mi, float(t), ax, ap, buf)
         return _frombuffer(buf)[: self._n_guards[mi]]
@@ -267,7 +273,7 @@ class Kernels:
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
         k = self.transition_index(transition)
-        ax, x, ap = self._xp(self._tr_nx[k][0], x, p)
+        ax, x, ap, p = self._xp(self._tr_nx[k][0], x, p)
         buf = _out(self.nx_max + 1)  # the post state, then the target's index (an int in the last slot)
         a0 = _addressof(buf)
         if self._c_reset(k, float(t), ax, ap, a0, a0 + 8 * self.nx_max):
@@ -277,7 +283,7 @@ class Kernels:
 
     # -- exact derivatives (generated from the symbolic model; see backend/variational_codegen.py)
     def _need_derivatives(self) -> None:
-        if not self.meta.get("derivatives"):
+        if not self._derivatives:
             raise ModelError(f"system {self.meta['name']!r}: these kernels were built without their derivatives; "
                              "use amble.compiled(system, derivatives=True)")
 
@@ -287,11 +293,10 @@ class Kernels:
         self._need_derivatives()
         mi = self.mode_index(mode)
         nx = self._nx[mi]
-        ax, x, ap = self._xp(nx, x, p)
+        ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(nx + nx * self.sc)  # f, then the rows of [∂f/∂x, ∂f/∂p] of sc columns
         a0 = _addressof(buf)
-        t = float(t)
-        if self._c_rhs_jac(mi, t, ax, ap, a0, a0 + 8 * nx) or self._c_rhs_jacp(mi, t, ax, ap, a0 + 8 * nx):
+        if self._c_rhs_jac_all(mi, float(t), ax, ap, a0, a0 + 8 * nx):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         out = _frombuffer(buf)
         J = out[nx:].reshape(nx, self.sc)
@@ -304,7 +309,7 @@ class Kernels:
         self._need_derivatives()
         mi = self.mode_index(mode)
         nx = self._nx[mi]
-        ax, x, ap = self._xp(nx, x, p)
+        ax, x, ap, p = self._xp(nx, x, p)
         buf = _out((max(self.n_tr, 1) + len(self.meta["switches"])) * self.sc)
         self._c_surfaces_grad(mi, float(t), ax, ap, buf)
         rows = self._n_surfaces[mi]
@@ -317,7 +322,7 @@ class Kernels:
         self._need_derivatives()
         k = self.transition_index(transition)
         nx, nd = self._tr_nx[k]
-        ax, x, ap = self._xp(nx, x, p)
+        ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(self.nx_max * (self.sc + 1))
         if self._c_reset_jac(k, float(t), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
@@ -486,6 +491,7 @@ _bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1
 _frombuffer = np.frombuffer
 _OUT: dict[int, type] = {}
 _NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
+_NO_PARAMS_ADDRESS = _NO_PARAMS.ctypes.data
 
 
 def _out(n: int) -> ctypes.Array:

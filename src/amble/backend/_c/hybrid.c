@@ -117,6 +117,12 @@ int amble_rhs_jacp(int mode, double t, const double *x, const double *p, double 
     return rhs_jacp(mode, t, x, p, J);
 }
 
+/* dx and the whole Jacobian row block [∂f/∂x, ∂f/∂p] (nx rows of SC columns) in one call. */
+int amble_rhs_jac_all(int mode, double t, const double *x, const double *p, double *dx, double *J) {
+    AMBLE_PARAMS(p);
+    return rhs_jac(mode, t, x, p, dx, J) || rhs_jacp(mode, t, x, p, J);
+}
+
 void amble_surfaces_grad(int mode, double t, const double *x, const double *p, double *G) {
     AMBLE_PARAMS(p);
     surfaces_grad(mode, t, x, p, G);
