@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import ctypes
 import statistics
+import subprocess
 import tempfile
 import time
 from collections.abc import Callable
@@ -38,6 +39,28 @@ REPEATS = 7
 GOAL_US = 3.0  # overhead of a per-state call from Python
 
 _D = ctypes.POINTER(ctypes.c_double)
+
+_TIMER_C = r"""
+#include <time.h>
+typedef void (*f1)(int, double, const double *, const double *, double *);
+typedef void (*f2)(int, double, const double *, const double *, double *, double *);
+typedef void (*f3)(int, double, const double *, const double *, double *, double *, double *);
+/* Seconds per call of an entry point with nout output pointers (out, out + o1, out + o2), over
+ * reps calls cycling through ns states of nx entries. */
+double amble_bench_entry(void *f, int nout, int index, int nx, int ns, const double *xs, const double *p,
+                         double *out, long o1, long o2, long reps) {
+    struct timespec a, b;
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    for (long r = 0; r < reps; ++r) {
+        const double *x = xs + (r % ns) * nx;
+        if (nout == 1) ((f1)f)(index, 0.0, x, p, out);
+        else if (nout == 2) ((f2)f)(index, 0.0, x, p, out, out + o1);
+        else ((f3)f)(index, 0.0, x, p, out, out + o1, out + o2);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &b);
+    return ((double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec)) / (double)reps;
+}
+"""
 
 
 def _loop(fn: Callable, args: list, reps: int) -> float:
@@ -79,22 +102,30 @@ def _typed_pointer_rhs(k):
     return rhs
 
 
-def _c_rhs_seconds(k, xs: np.ndarray, p: np.ndarray) -> float:
-    """Seconds per ``amble_rhs`` call in a C loop over the rows of ``xs`` (median of 5)."""
-    from benchmarks.bench_tree import _timer
+def _c_seconds(k, entries: dict[str, tuple[str, int, int, int]], xs: np.ndarray, p: np.ndarray,
+               reps: int) -> dict[str, float]:
+    """Seconds per call of each entry point (name → (C symbol, outputs, output offsets)) in a C
+    loop over the rows of ``xs`` (median of 5)."""
+    from amble.backend.cache import cflags, compiler
 
-    n = xs.shape[1] // 2
-    flat, dx, sink = np.ascontiguousarray(xs), np.zeros(2 * n), ctypes.c_double()
+    flat, out = np.ascontiguousarray(xs), np.zeros(4096)
+    a = lambda v: ctypes.c_void_p(v.ctypes.data)  # noqa: E731
+    got = {}
     with tempfile.TemporaryDirectory() as tmp:
-        timer = _timer(Path(tmp))
-        fptr = ctypes.cast(k._lib.amble_rhs, ctypes.c_void_p)
-        a = lambda v: ctypes.c_void_p(v.ctypes.data)  # noqa: E731
-        reps = max(20000, int(4e6 / (n * n)))
-        return statistics.median(timer.amble_bench_rhs(fptr, 0, n, len(xs), a(flat), a(p), a(dx), ctypes.c_long(reps),
-                                                       ctypes.byref(sink)) for _ in range(5))
+        src, so = Path(tmp) / "timer.c", Path(tmp) / "timer.so"
+        src.write_text(_TIMER_C)
+        subprocess.run([*compiler().split(), *cflags(), "-fPIC", "-shared", str(src), "-o", str(so)], check=True)
+        timer = ctypes.CDLL(str(so)).amble_bench_entry
+        timer.restype = ctypes.c_double
+        for name, (sym, nout, o1, o2) in entries.items():
+            f = ctypes.cast(getattr(k._lib, sym), ctypes.c_void_p)
+            got[name] = statistics.median(
+                timer(f, nout, 0, xs.shape[1], len(xs), a(flat), a(p), a(out), ctypes.c_long(o1), ctypes.c_long(o2),
+                      ctypes.c_long(reps)) for _ in range(5))
+    return got
 
 
-def _compass(quick: bool) -> tuple[list[list[str]], dict]:
+def _compass(quick: bool) -> dict:
     from amble.backend.kernels import compiled
     from amble.models import load
 
@@ -102,23 +133,25 @@ def _compass(quick: bool) -> tuple[list[list[str]], dict]:
     p = np.array(k.meta["param_defaults"])
     xs = np.random.default_rng(0).uniform(-0.5, 0.5, (STATES, 4))
     one = [(0, 0.0, x, p) for x in xs]
-    cands = {
-        "rhs, typed pointers (before)": (_typed_pointer_rhs(k), one),
-        "rhs": (k.rhs, one),
-        "dynamics (M, h, Γ)": (k.dynamics, one),
-        "guards": (k.guards, one),
-        "reset": (k.reset, one),
-        "rhs_jacobian (f, ∂f/∂x, ∂f/∂p)": (k.rhs_jacobian, one),
-        "surface_gradients": (k.surface_gradients, one),
-        "reset_jacobian": (k.reset_jacobian, one),
-    }
+    nxm, sc = k.nx_max, k.sc
+    # name: (the method, its C entry point, outputs, output offsets)
+    calls = {"rhs": (k.rhs, "amble_rhs", 1, 0, 0),
+             "dynamics": (k.dynamics, "amble_dynamics", 3, 4, 6),
+             "guards": (k.guards, "amble_guards", 1, 0, 0),
+             "reset": (k.reset, "amble_reset", 2, nxm, 0),
+             "rhs_jacobian": (k.rhs_jacobian, "amble_rhs_jac_all", 2, 4, 0),
+             "surface_gradients": (k.surface_gradients, "amble_surfaces_grad", 1, 0, 0),
+             "reset_jacobian": (k.reset_jacobian, "amble_reset_jac", 1, 0, 0)}
+    cands = {"rhs, typed pointers (before)": (_typed_pointer_rhs(k), one)}
+    cands.update({name: (c[0], one) for name, c in calls.items()})
     got = _interleaved(cands, 5000 if quick else 20000, 3 if quick else REPEATS)
-    c = _c_rhs_seconds(k, xs, p)
-    rows = [[name, f"{s['median'] * 1e6:.2f}", f"{s['min'] * 1e6:.2f}"] for name, s in got.items()]
-    return rows, {"calls": got, "rhs_c_s": c}
+    c_s = _c_seconds(k, {name: c[1:] for name, c in calls.items()}, xs, p, 200000)
+    c_s["rhs, typed pointers (before)"] = c_s["rhs"]
+    assert 4 + 4 * sc <= 4096 and nxm * (sc + 1) <= 4096
+    return {"calls": got, "c_s": c_s}
 
 
-def _biped(quick: bool) -> tuple[list[list[str]], dict]:
+def _biped(quick: bool) -> dict:
     from amble import HybridSystem, Model
     from amble.backend.kernels import compiled
 
@@ -130,7 +163,6 @@ def _biped(quick: bool) -> tuple[list[list[str]], dict]:
     p = np.zeros(max(len(k.meta["params"]), 1))
     cands = {"amble Kernels.rhs": (k.rhs, [(0, 0.0, x, p) for x in xs])}
     X = rng.uniform(-1.0, 1.0, (1000, 2 * n))
-    many = lambda X: k.rhs_many(0, 0.0, X, p)  # noqa: E731
     try:
         import pinocchio as pin
     except ImportError:
@@ -146,38 +178,42 @@ def _biped(quick: bool) -> tuple[list[list[str]], dict]:
         od, z = one.createData(), np.zeros(1)
         cands["Pinocchio binding (1-joint aba)"] = (lambda: pin.aba(one, od, z, z, z), [()])
     got = _interleaved(cands, 3000 if quick else 20000, 3 if quick else REPEATS)
-    batch = [_loop(many, [(X,)], 3 if quick else 20) / len(X) for _ in range(3 if quick else REPEATS)]
-    got["amble Kernels.rhs_many, per state (1000 per call)"] = {"median": statistics.median(batch), "min": min(batch)}
-    c = _c_rhs_seconds(k, xs, p)
-    rows = [[name, f"{s['median'] * 1e6:.2f}", f"{s['min'] * 1e6:.2f}"] for name, s in got.items()]
-    return rows, {"calls": got, "rhs_c_s": c, "pin_version": getattr(pin, "__version__", None), "n": n}
+    many = [_loop(lambda: k.rhs_many(0, 0.0, X, p), [()], 3 if quick else 20) / len(X)
+            for _ in range(3 if quick else REPEATS)]
+    got["amble Kernels.rhs_many, per state (1000 per call)"] = {"median": statistics.median(many), "min": min(many)}
+    c_s = _c_seconds(k, {"rhs": ("amble_rhs", 1, 0, 0)}, xs, p, 20000)["rhs"]
+    return {"calls": got, "rhs_c_s": c_s, "pin_version": getattr(pin, "__version__", None), "n": n}
+
+
+def _cell(s: float) -> str:
+    return f"{s * 1e6:.2f}"
 
 
 def run(quick: bool = False) -> Section:
-    crow, cdata = _compass(quick)
-    brow, bdata = _biped(quick)
-    cc, bc = cdata["calls"], bdata["calls"]
-    over = {name: s["median"] - cdata["rhs_c_s"] for name, s in cc.items()}
-    b_over = bc["amble Kernels.rhs"]["median"] - bdata["rhs_c_s"]
+    cd, bd = _compass(quick), _biped(quick)
+    cc, bc = cd["calls"], bd["calls"]
+    over = {name: s["median"] - cd["c_s"][name] for name, s in cc.items()}
+    crow = [[name, _cell(s["median"]), _cell(s["min"]), _cell(cd["c_s"][name]), _cell(over[name])]
+            for name, s in cc.items()]
+    b_over = bc["amble Kernels.rhs"]["median"] - bd["rhs_c_s"]
+    brow = [[name, _cell(s["median"]), _cell(s["min"])] for name, s in bc.items()]
     pin_bind = bc.get("Pinocchio binding (1-joint aba)")
-    md = ["Compass gait (4 states), µs per call from Python; the kernels themselves take "
-          f"{cdata['rhs_c_s'] * 1e6:.3f} µs (`amble_rhs` in a C loop):", "",
-          table(["call", "median µs", "min µs"], crow), "",
-          f"12-DOF biped (URDF), µs per call; amble's `amble_rhs` in a C loop: {bdata['rhs_c_s'] * 1e6:.2f} µs, "
-          f"so the call from Python adds {b_over * 1e6:.2f} µs"
-          + (f" (Pinocchio's binding: {pin_bind['median'] * 1e6:.2f} µs, measured in the same run)" if pin_bind
-             else "") + ":", "",
-          table(["call", "median µs", "min µs"], brow)]
+    md = ["Compass gait (4 states, 6 parameters), µs per call from Python; *C* is the same entry point "
+          "in a C loop over the same states, *overhead* = median − C:", "",
+          table(["call", "median µs", "min µs", "C µs", "overhead µs"], crow), "",
+          f"12-DOF biped (URDF), µs per call; `amble_rhs` in a C loop takes {_cell(bd['rhs_c_s'])} µs, so "
+          f"the call from Python adds {_cell(b_over)} µs"
+          + (f" (Pinocchio's binding: {_cell(pin_bind['median'])} µs in the same run)" if pin_bind else "") + ":",
+          "", table(["call", "median µs", "min µs"], brow)]
     if "Pinocchio pin.aba" in bc:
         r = bc["amble Kernels.rhs"]["median"] / bc["Pinocchio pin.aba"]["median"]
-        md += ["", f"amble `Kernels.rhs` / `pin.aba` from Python, same states, same run: {r:.2f}×"
-                   + (f" (Pinocchio {bdata['pin_version']})." if bdata["pin_version"] else ".")]
-    goals = [Goal(f"per-state call overhead from Python, {name.split(' (')[0]} (compass gait)", f"≤ {GOAL_US:g} µs",
-                  f"{over[name] * 1e6:.2f} µs", over[name] * 1e6 <= GOAL_US)
-             for name in cc if "before" not in name]
+        md += ["", f"amble `Kernels.rhs` / Pinocchio `pin.aba` from Python, same states, same run: {r:.2f}×"
+                   + (f" (Pinocchio {bd['pin_version']})." if bd["pin_version"] else ".")]
+    goals = [Goal(f"per-state call overhead from Python, {name} (compass gait)", f"≤ {GOAL_US:g} µs",
+                  f"{over[name] * 1e6:.2f} µs", over[name] * 1e6 <= GOAL_US) for name in cc if "before" not in name]
     goals.append(Goal("per-state call overhead from Python, rhs (12-DOF biped)", f"≤ {GOAL_US:g} µs",
                       f"{b_over * 1e6:.2f} µs", b_over * 1e6 <= GOAL_US))
-    return Section("Calls from Python", "\n".join(md), goals, {"compass": cdata, "biped12": bdata})
+    return Section("Calls from Python", "\n".join(md), goals, {"compass": cd, "biped12": bd})
 
 
 def main() -> None:

@@ -178,7 +178,8 @@ class Kernels:
     # -- single states (analysis, tests, a user's own loop); the hot path is amble_simulate.
     # Inputs: any array-like; a float64 C-contiguous writable ndarray of the right shape is handed
     # to C as it is (its address), anything else is converted first. Shapes are checked before any
-    # address reaches C. Every call returns fresh arrays (nothing is reused between calls).
+    # address reaches C. Every call returns fresh arrays (nothing is reused between calls); the
+    # arrays one call returns may be views of one buffer of its own (not C-contiguous, e.g. ∂f/∂x).
     def _fast_tables(self) -> None:
         """What the per-state calls look up, worked out once: mode and transition indices by
         name, state lengths, rows of guards and surfaces per mode, the entry points."""
@@ -196,6 +197,8 @@ class Kernels:
                              self._nx[modes.index(tr["source"])]) for tr in trs)
         self._p_seen: tuple[Any, int] = (None, 0)
         self._derivatives = bool(meta.get("derivatives"))
+        self._guard_len = max(self.n_tr, 1)
+        self._surface_len = (self._guard_len + len(meta["switches"])) * self.sc
         self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
         self._c_dynamics, self._c_rhs_jac_all = lib.amble_dynamics, lib.amble_rhs_jac_all
         self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
@@ -241,7 +244,7 @@ class Kernels:
 
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
-        mi = self.mode_index(mode)
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         nx = self._nx[mi]
         ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(nx)
@@ -252,7 +255,7 @@ class Kernels:
     def dynamics(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
-        mi = self.mode_index(mode)
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         nx = self._nx[mi]
         n = nx // 2
         ax, x, ap, p = self._xp(nx, x, p)
@@ -264,15 +267,15 @@ class Kernels:
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The guard values of the transitions from a mode, in order."""
-        mi = self.mode_index(mode)
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         ax, x, ap, p = self._xp(self._nx[mi], x, p)
-        buf = _out(max(self.n_tr, 1))
+        buf = _out(self._guard_len)
         self._c_guards(mi, float(t), ax, ap, buf)
         return _frombuffer(buf)[: self._n_guards[mi]]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
-        k = self.transition_index(transition)
+        k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
         ax, x, ap, p = self._xp(self._tr_nx[k][0], x, p)
         buf = _out(self.nx_max + 1)  # the post state, then the target's index (an int in the last slot)
         a0 = _addressof(buf)
@@ -291,7 +294,7 @@ class Kernels:
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
         self._need_derivatives()
-        mi = self.mode_index(mode)
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         nx = self._nx[mi]
         ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(nx + nx * self.sc)  # f, then the rows of [∂f/∂x, ∂f/∂p] of sc columns
@@ -300,34 +303,34 @@ class Kernels:
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         out = _frombuffer(buf)
         J = out[nx:].reshape(nx, self.sc)
-        return out[:nx], J[:, :nx].copy(), J[:, self.nx_max : self.nx_max + self._npar].copy()
+        return out[:nx], J[:, :nx], J[:, self.nx_max : self.nx_max + self._npar]
 
     def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray]:
         """``(∂g/∂x, ∂g/∂p)`` of a mode's guards (one row per transition from it, in order), then
         its switching surfaces."""
         self._need_derivatives()
-        mi = self.mode_index(mode)
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         nx = self._nx[mi]
         ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out((max(self.n_tr, 1) + len(self.meta["switches"])) * self.sc)
+        buf = _out(self._surface_len)
         self._c_surfaces_grad(mi, float(t), ax, ap, buf)
         rows = self._n_surfaces[mi]
         G = _frombuffer(buf)[: rows * self.sc].reshape(rows, self.sc)
-        return G[:, :nx].copy(), G[:, self.nx_max : self.nx_max + self._npar].copy()
+        return G[:, :nx], G[:, self.nx_max : self.nx_max + self._npar]
 
     def reset_jacobian(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
         self._need_derivatives()
-        k = self.transition_index(transition)
+        k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
         nx, nd = self._tr_nx[k]
         ax, x, ap, p = self._xp(nx, x, p)
         buf = _out(self.nx_max * (self.sc + 1))
         if self._c_reset_jac(k, float(t), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
         D = _frombuffer(buf).reshape(self.nx_max, self.sc + 1)
-        return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + self._npar].copy(), D[:nd, self.sc].copy()
+        return D[:nd, :nx], D[:nd, self.nx_max : self.nx_max + self._npar], D[:nd, self.sc]
 
     # -- many states per call: one compiled loop over the rows (amble_rows; the GIL is released)
     def _many(self, op: str, mode: str | int, t: Any, X: Any, p: Any, width: int) -> np.ndarray:
