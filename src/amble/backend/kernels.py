@@ -56,7 +56,7 @@ def compiled(system: HybridSystem, derivatives: bool = False) -> Kernels:
     A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
     found by the warm-start index) is served those; without the ones asked for, its full system
     is built."""
-    if isinstance(system, CarriesKernels):
+    if _carries_kernels(system):
         k = system.compiled_kernels(derivatives)
         if k is not None:
             return k
@@ -73,6 +73,19 @@ def compiled(system: HybridSystem, derivatives: bool = False) -> Kernels:
     if k.meta.get("derivatives"):  # from now on it serves plain runs too, as _load prefers it
         _SERVED[(served[0], not derivatives, *served[2:])] = entry
     return k
+
+
+#: Whether instances of a class carry their kernels (:class:`CarriesKernels`), by class: the check
+#: of a runtime-checkable protocol looks the class over afresh on every call (tens of µs).
+_CARRIES: dict[type, bool] = {}
+
+
+def _carries_kernels(system: Any) -> bool:
+    kind = type(system)
+    known = _CARRIES.get(kind)
+    if known is None:
+        known = _CARRIES[kind] = isinstance(system, CarriesKernels)
+    return known
 
 
 #: What :func:`compiled` served, by (id of the system, derivatives asked, its
