@@ -185,12 +185,58 @@ def _biped(quick: bool) -> dict:
     return {"calls": got, "rhs_c_s": c_s, "pin_version": getattr(pin, "__version__", None), "n": n}
 
 
+def _fixed(quick: bool) -> dict:
+    """Fixed cost per call of ``engine.run`` and ``simulate``: a one-step compass-gait walk from its
+    fixed-point guess, minus the compiled call of the same run (context reset from a template
+    and ``amble_simulate`` called on ready addresses; recording on the 0.01 s grid into ready
+    buffers for ``simulate``)."""
+    import math
+
+    from amble import simulate
+    from amble.backend.abi import CODE, CTX, CTX_X, IOPT, OPT
+    from amble.backend.kernels import compiled
+    from amble.models import load
+    from amble.simulation import engine
+
+    system = load("compass-gait")
+    k = compiled(system)
+    p = np.array(k.meta["param_defaults"])
+    x0 = np.array(system.fixed_point_guess, dtype=float)
+    opts = engine.Options()
+    start = np.zeros(CTX_X + k.nx_max)
+    start[CTX["TPREV_EVENT"]], start[CTX["FRESH"]], start[CTX_X : CTX_X + 4] = -math.inf, 1.0, x0
+    ctx = start.copy()
+    STEPS_DONE = CODE["STEPS_DONE"]  # noqa: N806
+
+    def compiled_call(sample_dt: float):
+        opt, iopt = opts._opt.copy(), opts._iopt.copy()
+        opt[OPT["TEND"]], opt[OPT["SAMPLEDT"]], iopt[IOPT["MAXSTEPS"]] = math.inf, sample_dt, 1
+        buf = engine._Buffers(engine._first_rows(k.nx_max, engine.RECORD_BUDGET), engine._FIRST_EVENTS, k.nx_max) \
+            if sample_dt else engine._NO_RECORDING
+        iopt[IOPT["OUTCAP"]], iopt[IOPT["EVCAP"]] = buf.cap, buf.ecap
+        addrs = (p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data, *buf._addresses, None)
+        n, ne = buf._counts
+
+        def call(keep=(opt, iopt, buf)):  # the arrays behind the addresses stay alive with the closure
+            ctx[:] = start
+            n[0] = ne[0] = 0
+            code = k.simulate_raw(*addrs)
+            assert code == STEPS_DONE, code
+        return call
+
+    cands = {"engine.run, 1 step": (lambda: engine.run(k, p, 0, x0, steps=1, opts=opts), [()]),
+             "compiled call of that run": (compiled_call(0.0), [()]),
+             "simulate, 1 step": (lambda: simulate(system, x0=x0, steps=1), [()]),
+             "compiled call of that simulate": (compiled_call(0.01), [()])}
+    return _interleaved(cands, 200 if quick else 1000, 3 if quick else REPEATS)
+
+
 def _cell(s: float) -> str:
     return f"{s * 1e6:.2f}"
 
 
 def run(quick: bool = False) -> Section:
-    cd, bd = _compass(quick), _biped(quick)
+    cd, bd, fd = _compass(quick), _biped(quick), _fixed(quick)
     cc, bc = cd["calls"], bd["calls"]
     over = {name: s["median"] - cd["c_s"][name] for name, s in cc.items()}
     crow = [[name, _cell(s["median"]), _cell(s["min"]), _cell(cd["c_s"][name]), _cell(over[name])]
@@ -209,11 +255,20 @@ def run(quick: bool = False) -> Section:
         r = bc["amble Kernels.rhs"]["median"] / bc["Pinocchio pin.aba"]["median"]
         md += ["", f"amble `Kernels.rhs` / Pinocchio `pin.aba` from Python, same states, same run: {r:.2f}×"
                    + (f" (Pinocchio {bd['pin_version']})." if bd["pin_version"] else ".")]
+    fixed = {"run": fd["engine.run, 1 step"]["median"] - fd["compiled call of that run"]["median"],
+             "simulate": fd["simulate, 1 step"]["median"] - fd["compiled call of that simulate"]["median"]}
+    md += ["", "Fixed cost per call: a one-step compass-gait walk, µs; *fixed* = the call − its compiled "
+               "part (the same run's `amble_simulate` call on ready arrays):", "",
+           table(["call", "median µs", "min µs"], [[name, _cell(v["median"]), _cell(v["min"])]
+                                                    for name, v in fd.items()]),
+           "", f"Fixed cost: `engine.run` {_cell(fixed['run'])} µs, `simulate` {_cell(fixed['simulate'])} µs."]
     goals = [Goal(f"per-state call overhead from Python, {name} (compass gait)", f"≤ {GOAL_US:g} µs",
                   f"{over[name] * 1e6:.2f} µs", over[name] * 1e6 <= GOAL_US) for name in cc if "before" not in name]
     goals.append(Goal("per-state call overhead from Python, rhs (12-DOF biped)", f"≤ {GOAL_US:g} µs",
                       f"{b_over * 1e6:.2f} µs", b_over * 1e6 <= GOAL_US))
-    return Section("Calls from Python", "\n".join(md), goals, {"compass": cd, "biped12": bd})
+    goals += [Goal(f"fixed cost per call, {name}", f"≤ {limit} µs", f"{fixed[name] * 1e6:.1f} µs",
+                   fixed[name] * 1e6 <= limit) for name, limit in (("run", 20), ("simulate", 40))]
+    return Section("Calls from Python", "\n".join(md), goals, {"compass": cd, "biped12": bd, "fixed": fd})
 
 
 def main() -> None:
