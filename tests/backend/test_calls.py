@@ -160,3 +160,18 @@ def test_wrong_shapes_and_types_raise_typed_errors_before_c(kp):
         k.rhs_many(0, 0.0, np.zeros((3, 4)), np.zeros((2, len(p))))
     with pytest.raises(ParameterError):
         k.dynamics_many(0, 0.0, np.zeros((3, 4)), p[:-1])
+
+
+def test_a_run_reads_read_only_parameters_and_refuses_strided_ones(compass):
+    from amble.simulation import engine
+
+    k = compiled(compass)
+    p = np.array(k.meta["param_defaults"])
+    x0 = np.array(compass.fixed_point_guess, dtype=float)
+    want = engine.run(k, p, 0, x0, steps=1)
+    ro = p.copy()
+    ro.flags.writeable = False
+    got = engine.run(k, ro, 0, x0, steps=1)
+    assert got.status == want.status and np.array_equal(got.x, want.x) and got.t == want.t
+    with pytest.raises(StateError):
+        engine.run(k, np.repeat(p, 2)[::2], 0, x0, steps=1)
