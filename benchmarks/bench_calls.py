@@ -239,14 +239,17 @@ def run(quick: bool = False) -> Section:
     cd, bd, fd = _compass(quick), _biped(quick), _fixed(quick)
     cc, bc = cd["calls"], bd["calls"]
     over = {name: s["median"] - cd["c_s"][name] for name, s in cc.items()}
-    crow = [[name, _cell(s["median"]), _cell(s["min"]), _cell(cd["c_s"][name]), _cell(over[name])]
-            for name, s in cc.items()]
+    pin_bind = bc.get("Pinocchio binding (1-joint aba)")
+    # the overhead in units of Pinocchio's binding (another run's): load on the machine slows both alike
+    per_bind = (lambda v: f"{v / pin_bind['median']:.1f}×") if pin_bind else (lambda v: "—")
+    crow = [[name, _cell(s["median"]), _cell(s["min"]), _cell(cd["c_s"][name]), _cell(over[name]),
+             per_bind(over[name])] for name, s in cc.items()]
     b_over = bc["amble Kernels.rhs"]["median"] - bd["rhs_c_s"]
     brow = [[name, _cell(s["median"]), _cell(s["min"])] for name, s in bc.items()]
-    pin_bind = bc.get("Pinocchio binding (1-joint aba)")
     md = ["Compass gait (4 states, 6 parameters), µs per call from Python; *C* is the same entry point "
-          "in a C loop over the same states, *overhead* = median − C:", "",
-          table(["call", "median µs", "min µs", "C µs", "overhead µs"], crow), "",
+          "in a C loop over the same states, *overhead* = median − C, beside the Pinocchio binding's own "
+          "cost (the 1-joint `aba` of the biped table):", "",
+          table(["call", "median µs", "min µs", "C µs", "overhead µs", "overhead / Pinocchio binding"], crow), "",
           f"12-DOF biped (URDF), µs per call; `amble_rhs` in a C loop takes {_cell(bd['rhs_c_s'])} µs, so "
           f"the call from Python adds {_cell(b_over)} µs"
           + (f" (Pinocchio's binding: {_cell(pin_bind['median'])} µs in the same run)" if pin_bind else "") + ":",
