@@ -74,6 +74,14 @@ METHODS: tuple[tuple[int, str, bool, bool], ...] = (
     (2, "tsit5", False, True),    # Tsitouras 5(4), explicit, free 4th-order dense output
 )
 
+#: What ``amble_rows`` evaluates at many states in one call: (code, name, what a row of its output
+#: holds). ``nx``: the mode's state length, ``nq = nx / 2``, ``SC`` as below.
+ROW_OPS: tuple[tuple[int, str, str], ...] = (
+    (0, "RHS", "dx/dt (nx)"),
+    (1, "DYNAMICS", "M (nq × nq, row-major), h (nq), Γ (nq)"),
+    (2, "RHS_JAC", "dx/dt (nx), then [∂f/∂x, ∂f/∂p] (nx rows of SC columns)"),
+)
+
 #: The sensitivity buffer (float64, ``_c/sensitivity.h``) of a run that carries ∂x/∂(x0, p), in
 #: order: (name, size as coefficients (a, b, c) of ``a·NXMAX·SC + b·SC + c``). ``NXMAX`` is a
 #: library's longest state, ``SC = NXMAX + NPARAM`` the columns of a sensitivity row (state
@@ -115,6 +123,7 @@ OPT = {name: i for i, name in enumerate(OPT_FIELDS)}
 IOPT = {name: i for i, name in enumerate(IOPT_FIELDS)}
 CODE = {name: code for code, name, _ in STATUS}
 METHOD = {name: code for code, name, _, _ in METHODS}
+ROW_OP = {name: code for code, name, _ in ROW_OPS}
 NEEDS_JACOBIAN = {name: jac for _, name, jac, _ in METHODS}
 HAS_SENSITIVITIES = {name: sens for _, name, _, sens in METHODS}
 OUTCOME = {code: outcome for code, _, outcome in STATUS}
@@ -128,6 +137,7 @@ def _layout_text() -> str:
     parts += [f"OP_{n}={i}" for n, i in OPT.items()] + [f"IO_{n}={i}" for n, i in IOPT.items()]
     parts += [f"SENS_{n}={c}" for n, c in _sens_offsets().items()]
     parts += [f"MT_{n.upper()}={c}" for c, n, _, _ in METHODS]
+    parts += [f"ROP_{n}={c}" for c, n, _ in ROW_OPS]
     return ";".join(parts)
 
 
@@ -137,9 +147,9 @@ LAYOUT = int(sha256(_layout_text().encode()).hexdigest()[:15], 16)
 
 def c_header(layout: int | None = None) -> str:
     """The C side of these tables: ``#define ST_*``, ``CX_*``, ``OP_*``, ``IO_*``, ``MT_*`` (method
-    codes) and ``N_METHODS``, ``SENS_*`` (offsets in terms of the unit's ``NXMAX`` and ``SC``) and
-    ``AMBLE_LAYOUT`` (default
-    :data:`LAYOUT`), written into every generated translation unit before the engine is included.
+    codes) and ``N_METHODS``, ``ROP_*`` (operations of ``amble_rows``), ``SENS_*`` (offsets in
+    terms of the unit's ``NXMAX`` and ``SC``) and ``AMBLE_LAYOUT`` (default :data:`LAYOUT`), written
+    into every generated translation unit before the engine is included.
     Integer arrays shared with NumPy int64 are ``int64_t``."""
     lines = ["/* Python <-> C interface, generated from amble/backend/abi.py; do not edit. */",
              "#include <stdint.h>"]
@@ -149,6 +159,7 @@ def c_header(layout: int | None = None) -> str:
     lines += [f"#define IO_{name} {i}" for name, i in IOPT.items()] + [f"#define IOPT_LEN {len(IOPT)}"]
     lines += [f"#define MT_{name.upper()} {code}" for code, name, _, _ in METHODS]
     lines.append(f"#define N_METHODS {len(METHODS)}")
+    lines += [f"#define ROP_{name} {code}" for code, name, _ in ROW_OPS]
     lines += [f"#define SENS_{name} {_sens_c(c)}" for name, c in _sens_offsets().items()]
     lines.append(f"#define AMBLE_LAYOUT {LAYOUT if layout is None else layout}LL")
     return "\n".join(lines) + "\n"

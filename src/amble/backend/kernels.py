@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 import ctypes
+import operator
 import threading
 import weakref
 from pathlib import Path
@@ -18,14 +19,14 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..errors import CompileError, ModelError, StateError
+from ..errors import CompileError, ModelError, ParameterError, StateError
 from . import abi, cache
 from .cache import cache_dir, structure_key
 
 if TYPE_CHECKING:  # loading a cached library imports no SymPy
     from ..modelling.hybrid import HybridSystem
 
-__all__ = ["Kernels", "build", "cache_dir", "compiled", "structure_key"]
+__all__ = ["Kernels", "address", "build", "cache_dir", "compiled", "structure_key"]
 
 _LOADED: dict[str, Kernels] = {}
 
@@ -55,7 +56,7 @@ def compiled(system: HybridSystem, derivatives: bool = False) -> Kernels:
     A system that carries its compiled kernels (:class:`~amble.backend.compiled.CompiledSystem`,
     found by the warm-start index) is served those; without the ones asked for, its full system
     is built."""
-    if isinstance(system, CarriesKernels):
+    if _carries_kernels(system):
         k = system.compiled_kernels(derivatives)
         if k is not None:
             return k
@@ -72,6 +73,19 @@ def compiled(system: HybridSystem, derivatives: bool = False) -> Kernels:
     if k.meta.get("derivatives"):  # from now on it serves plain runs too, as _load prefers it
         _SERVED[(served[0], not derivatives, *served[2:])] = entry
     return k
+
+
+#: Whether instances of a class carry their kernels (:class:`CarriesKernels`), by class: the check
+#: of a runtime-checkable protocol looks the class over afresh on every call (tens of µs).
+_CARRIES: dict[type, bool] = {}
+
+
+def _carries_kernels(system: Any) -> bool:
+    kind = type(system)
+    known = _CARRIES.get(kind)
+    if known is None:
+        known = _CARRIES[kind] = isinstance(system, CarriesKernels)
+    return known
 
 
 #: What :func:`compiled` served, by (id of the system, derivatives asked, its
@@ -144,21 +158,23 @@ class Kernels:
         # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
         # evaluation, and building typed ctypes pointers costs more than a walking step.
         lib.amble_simulate.argtypes = [ctypes.c_void_p] * 14
-        lib.amble_rhs.restype = ctypes.c_int
-        lib.amble_rhs.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_guards.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_reset.restype = ctypes.c_int
-        lib.amble_reset.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _iptr]
-        lib.amble_dynamics.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr, _dptr]
+        # The per-state entry points take raw addresses (void *): typed ctypes pointers built per call
+        # (ndarray.ctypes.data_as) cost several times the call itself.
+        ptrs = lambda n: [ctypes.c_void_p] * n  # noqa: E731
+        for name, res, args in (("amble_rhs", ctypes.c_int, ptrs(3)), ("amble_guards", None, ptrs(3)),
+                                ("amble_reset", ctypes.c_int, ptrs(4)), ("amble_dynamics", None, ptrs(5)),
+                                ("amble_rhs_jac", ctypes.c_int, ptrs(4)), ("amble_rhs_jacp", ctypes.c_int, ptrs(3)),
+                                ("amble_rhs_jac_all", ctypes.c_int, ptrs(4)),
+                                ("amble_surfaces_grad", None, ptrs(3)), ("amble_reset_jac", ctypes.c_int, ptrs(3))):
+            f = getattr(lib, name)
+            f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *args]
         lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
-        lib.amble_rhs_jac.restype = ctypes.c_int
-        lib.amble_rhs_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr, _dptr]
-        lib.amble_rhs_jacp.restype = ctypes.c_int
-        lib.amble_rhs_jacp.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_surfaces_grad.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
-        lib.amble_reset_jac.restype = ctypes.c_int
-        lib.amble_reset_jac.argtypes = [ctypes.c_int, ctypes.c_double, _dptr, _dptr, _dptr]
+        lib.amble_rows.restype = ctypes.c_int64
+        lib.amble_rows.argtypes = [ctypes.c_int64, ctypes.c_int, ctypes.c_int, ctypes.c_void_p, ctypes.c_int64,
+                                   ctypes.c_void_p, ctypes.c_int64, ctypes.c_void_p, ctypes.c_int64,
+                                   ctypes.c_void_p, ctypes.c_int64]
+        self._fast_tables()
         self.simulate_raw = lib.amble_simulate
         lib.amble_walk_batch.restype = None
         lib.amble_walk_batch.argtypes = [ctypes.c_int64, ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 2 + \
@@ -172,60 +188,118 @@ class Kernels:
                                             ctypes.c_void_p, ctypes.c_void_p]
         self._project_batch = lib.amble_project_batch
 
-    # -- conveniences over single states (analysis, tests); the hot path is amble_simulate
+    # -- single states (analysis, tests, a user's own loop); the hot path is amble_simulate.
+    # Inputs: any array-like; a float64 C-contiguous writable ndarray of the right shape is handed
+    # to C as it is (its address), anything else is converted first. Shapes are checked before any
+    # address reaches C. Every call returns fresh arrays (nothing is reused between calls); the
+    # arrays one call returns may be views of one buffer of its own (not C-contiguous, e.g. ∂f/∂x).
+    def _fast_tables(self) -> None:
+        """What the per-state calls look up, worked out once: mode and transition indices by
+        name, state lengths, rows of guards and surfaces per mode, the entry points."""
+        meta, lib = self.meta, self._lib
+        modes, trs = meta["modes"], meta["transitions"]
+        self._mode_ix = {m: i for i, m in enumerate(modes)}
+        self._tr_ix = {tr["name"]: i for i, tr in enumerate(trs)}
+        self._nx = tuple(meta["nx"])
+        self._npar = len(meta["params"])
+        self._n_guards = tuple(sum(tr["source"] == m for tr in trs) for m in modes)
+        self._n_surfaces = tuple(g + sum(sw["mode"] == m for sw in meta["switches"])
+                                 for m, g in zip(modes, self._n_guards))
+        self._tr_nx = tuple((self._nx[modes.index(tr["source"])],
+                             self._nx[modes.index(tr["target"])] if tr["target"] else
+                             self._nx[modes.index(tr["source"])]) for tr in trs)
+        self._p_seen: tuple[Any, int] = (None, 0)
+        self._derivatives = bool(meta.get("derivatives"))
+        self._guard_len = max(self.n_tr, 1)
+        self._surface_len = (self._guard_len + len(meta["switches"])) * self.sc
+        self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
+        self._c_dynamics, self._c_rhs_jac_all = lib.amble_dynamics, lib.amble_rhs_jac_all
+        self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
+
     def mode_index(self, mode: str | int) -> int:
-        if isinstance(mode, int):
+        """The index of a mode given by name or index (:class:`~amble.errors.ModelError` if none)."""
+        if type(mode) is int and 0 <= mode < self.n_modes:
             return mode
-        try:
-            return self.meta["modes"].index(mode)
-        except ValueError:
-            raise ModelError(f"unknown mode {mode!r}; modes: {', '.join(self.meta['modes'])}") from None
+        i = self._mode_ix.get(mode) if isinstance(mode, str) else _index(mode, self.n_modes)
+        if i is None:
+            raise ModelError(f"unknown mode {mode!r}; modes: {', '.join(self.meta['modes'])} "
+                             f"(or their indices 0 … {self.n_modes - 1})")
+        return i
+
+    def transition_index(self, transition: str | int) -> int:
+        """The index of a transition given by name or index (:class:`~amble.errors.ModelError` if none)."""
+        if type(transition) is int and 0 <= transition < self.n_tr:
+            return transition
+        i = self._tr_ix.get(transition) if isinstance(transition, str) else _index(transition, self.n_tr)
+        if i is None:
+            raise ModelError(f"unknown transition {transition!r}; transitions: {', '.join(self._tr_ix)} "
+                             f"(or their indices 0 … {self.n_tr - 1})")
+        return i
+
+    def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
+        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
+        the arrays at them (to keep alive until the call returns). The caller's last parameter
+        array is remembered with its address: it is passed call after call, and holding it keeps
+        its memory where it is (NumPy refuses to resize an array that is referenced)."""
+        ax, x = _arg(x, nx, StateError, "state")
+        seen = self._p_seen
+        if p is seen[0] and p.dtype is _F64:
+            return ax, x, seen[1], p
+        if self._npar == 0:  # no parameters: any placeholder of ≤ 1 entry (C reads none of it)
+            if np.size(p) > 1:
+                raise ParameterError(f"system {self.meta['name']!r} has no parameters, got {np.size(p)} values")
+            q, ap = _NO_PARAMS, _NO_PARAMS_ADDRESS
+        else:
+            ap, q = _arg(p, self._npar, ParameterError, "parameter vector")
+        if type(p) is np.ndarray and (q is p or self._npar == 0):  # only the caller's own array is remembered
+            self._p_seen = (p, ap)
+        return ax, x, ap, q
 
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
-        mi = self.mode_index(mode)
-        x = _vec(x, self.meta["nx"][mi])
-        dx = np.zeros_like(x)
-        err = self._lib.amble_rhs(mi, float(t), _p(x), _p(p), _p(dx))
-        if err:
+        """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
+        nx = self._nx[mi]
+        ax, x, ap, p = self._xp(nx, x, p)
+        buf = _out(nx)
+        if self._c_rhs(mi, float(t), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        return dx
+        return _frombuffer(buf)
 
     def dynamics(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
-        mi = self.mode_index(mode)
-        nx = self.meta["nx"][mi]
-        x = _vec(x, nx)
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
+        nx = self._nx[mi]
         n = nx // 2
-        M, h, G = np.zeros((n, n)), np.zeros(n), np.zeros(n)
-        self._lib.amble_dynamics(mi, float(t), _p(x), _p(p), _p(M), _p(h), _p(G))
-        return M, h, G
+        ax, x, ap, p = self._xp(nx, x, p)
+        buf = _out(n * n + 2 * n)
+        a0 = _addressof(buf)
+        self._c_dynamics(mi, float(t), ax, ap, a0, a0 + 8 * n * n, a0 + 8 * (n * n + n))
+        out = _frombuffer(buf)
+        return out[: n * n].reshape(n, n), out[n * n : n * n + n], out[n * n + n :]
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
-        mi = self.mode_index(mode)
-        x = _vec(x, self.meta["nx"][mi])
-        g = np.zeros(max(self.n_tr, 1))
-        self._lib.amble_guards(mi, float(t), _p(x), _p(p), _p(g))
-        n = sum(1 for tr in self.meta["transitions"] if tr["source"] == self.meta["modes"][mi])
-        return g[:n]
+        """The guard values of the transitions from a mode, in order."""
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
+        ax, x, ap, p = self._xp(self._nx[mi], x, p)
+        buf = _out(self._guard_len)
+        self._c_guards(mi, float(t), ax, ap, buf)
+        return _frombuffer(buf)[: self._n_guards[mi]]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
-        trs = self.meta["transitions"]
-        k = transition if isinstance(transition, int) else [tr["name"] for tr in trs].index(transition)
-        src = self.meta["modes"].index(trs[k]["source"])
-        x = _vec(x, self.meta["nx"][src])
-        out = np.zeros(self.nx_max)
-        target = ctypes.c_int(-1)
-        err = self._lib.amble_reset(k, float(t), _p(x), _p(p), _p(out), ctypes.byref(target))
-        if err:
-            raise ModelError(f"reset of {trs[k]['name']!r} failed (singular impulse system)")
-        mode = self.meta["modes"][target.value]
-        return mode, out[: self.meta["nx"][target.value]].copy()
+        k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
+        ax, x, ap, p = self._xp(self._tr_nx[k][0], x, p)
+        buf = _out(self.nx_max + 1)  # the post state, then the target's index (an int in the last slot)
+        a0 = _addressof(buf)
+        if self._c_reset(k, float(t), ax, ap, a0, a0 + 8 * self.nx_max):
+            raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
+        target = ctypes.c_int.from_buffer(buf, 8 * self.nx_max).value
+        return self.meta["modes"][target], _frombuffer(buf)[: self._nx[target]]
 
     # -- exact derivatives (generated from the symbolic model; see backend/variational_codegen.py)
     def _need_derivatives(self) -> None:
-        if not self.meta.get("derivatives"):
+        if not self._derivatives:
             raise ModelError(f"system {self.meta['name']!r}: these kernels were built without their derivatives; "
                              "use amble.compiled(system, derivatives=True)")
 
@@ -233,47 +307,96 @@ class Kernels:
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
         self._need_derivatives()
-        mi = self.mode_index(mode)
-        nx = self.meta["nx"][mi]
-        x = _vec(x, nx)
-        dx, J = np.zeros(nx), np.zeros((nx, self.sc))
-        err = self._lib.amble_rhs_jac(mi, float(t), _p(x), _p(p), _p(dx), _p(J))
-        err = err or self._lib.amble_rhs_jacp(mi, float(t), _p(x), _p(p), _p(J))
-        if err:
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
+        nx = self._nx[mi]
+        ax, x, ap, p = self._xp(nx, x, p)
+        buf = _out(nx + nx * self.sc)  # f, then the rows of [∂f/∂x, ∂f/∂p] of sc columns
+        a0 = _addressof(buf)
+        if self._c_rhs_jac_all(mi, float(t), ax, ap, a0, a0 + 8 * nx):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        npar = len(self.meta["params"])
-        return dx, J[:, :nx].copy(), J[:, self.nx_max : self.nx_max + npar].copy()
+        out = _frombuffer(buf)
+        J = out[nx:].reshape(nx, self.sc)
+        return out[:nx], J[:, :nx], J[:, self.nx_max : self.nx_max + self._npar]
 
     def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray]:
         """``(∂g/∂x, ∂g/∂p)`` of a mode's guards (one row per transition from it, in order), then
         its switching surfaces."""
         self._need_derivatives()
-        mi = self.mode_index(mode)
-        nx = self.meta["nx"][mi]
-        x = _vec(x, nx)
-        G = np.zeros((max(self.n_tr, 1) + len(self.meta["switches"]), self.sc))
-        self._lib.amble_surfaces_grad(mi, float(t), _p(x), _p(p), _p(G))
-        rows = sum(1 for tr in self.meta["transitions"] if tr["source"] == self.meta["modes"][mi])
-        rows += sum(1 for sw in self.meta["switches"] if sw["mode"] == self.meta["modes"][mi])
-        npar = len(self.meta["params"])
-        return G[:rows, :nx].copy(), G[:rows, self.nx_max : self.nx_max + npar].copy()
+        mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
+        nx = self._nx[mi]
+        ax, x, ap, p = self._xp(nx, x, p)
+        buf = _out(self._surface_len)
+        self._c_surfaces_grad(mi, float(t), ax, ap, buf)
+        rows = self._n_surfaces[mi]
+        G = _frombuffer(buf)[: rows * self.sc].reshape(rows, self.sc)
+        return G[:, :nx], G[:, self.nx_max : self.nx_max + self._npar]
 
-    def reset_jacobian(self, transition: int, t: float, x: np.ndarray, p: np.ndarray
+    def reset_jacobian(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
         self._need_derivatives()
-        trs = self.meta["transitions"]
-        src = self.meta["modes"].index(trs[transition]["source"])
-        dst = self.meta["modes"].index(trs[transition]["target"]) if trs[transition]["target"] else src
-        nx, nd = self.meta["nx"][src], self.meta["nx"][dst]
-        x = _vec(x, nx)
-        D = np.zeros((self.nx_max, self.sc + 1))
-        err = self._lib.amble_reset_jac(transition, float(t), _p(x), _p(p), _p(D))
-        if err:
-            raise ModelError(f"reset of {trs[transition]['name']!r} failed (singular impulse system)")
-        npar = len(self.meta["params"])
-        return D[:nd, :nx].copy(), D[:nd, self.nx_max : self.nx_max + npar].copy(), D[:nd, self.sc].copy()
+        k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
+        nx, nd = self._tr_nx[k]
+        ax, x, ap, p = self._xp(nx, x, p)
+        buf = _out(self.nx_max * (self.sc + 1))
+        if self._c_reset_jac(k, float(t), ax, ap, buf):
+            raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
+        D = _frombuffer(buf).reshape(self.nx_max, self.sc + 1)
+        return D[:nd, :nx], D[:nd, self.nx_max : self.nx_max + self._npar], D[:nd, self.sc]
+
+    # -- many states per call: one compiled loop over the rows (amble_rows; the GIL is released)
+    def _many(self, op: str, mode: str | int, t: Any, X: Any, p: Any, width: int) -> np.ndarray:
+        """Operation ``op`` (:data:`amble.backend.abi.ROW_OPS`) of ``mode`` at every row of ``X``;
+        ``width`` output entries per row. ``t``: one time or one per row; ``p``: one parameter
+        vector or one row per state."""
+        mi = self.mode_index(mode)
+        nx = self._nx[mi]
+        X = _matrix(X, nx, StateError, "states")
+        n = X.shape[0]
+        try:
+            t = np.asarray(t, dtype=np.float64)
+            P = np.ascontiguousarray(p if self._npar or np.size(p) > 1 else _NO_PARAMS, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise StateError("times and parameters must be real numbers") from None
+        if t.ndim > 1 or (t.ndim == 1 and t.shape != (n,)):
+            raise StateError(f"times must be one number or one per state ({n}), got shape {t.shape}")
+        t, ts = np.ascontiguousarray(t), t.ndim  # a 0-d time becomes one entry read by every row
+        npar = self._npar or 1
+        if P.shape != (npar,) and P.shape != (n, npar):
+            raise ParameterError(f"parameters must be one vector of {self._npar} or one row of {self._npar} "
+                                 f"per state, got shape {P.shape}")
+        out = np.zeros((n, width))
+        bad = self._lib.amble_rows(n, abi.ROW_OP[op], mi, t.ctypes.data, ts, X.ctypes.data, nx, P.ctypes.data,
+                                   npar if P.ndim == 2 else 0, out.ctypes.data, width)
+        if bad >= 0:
+            raise ModelError(f"mass matrix is singular or ill-conditioned at state {X[bad].tolist()} (row {bad})")
+        return out
+
+    def rhs_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """:meth:`rhs` at every row of ``X`` (``n × nx``) in one compiled call: ``n × nx``.
+        ``t``: one time or one per row; ``p``: one parameter vector or one row per state. Each
+        row equals :meth:`rhs` of that row, bit for bit."""
+        return self._many("RHS", mode, t, X, p, self._nx[self.mode_index(mode)])
+
+    def dynamics_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`dynamics` at every row of ``X`` in one compiled call: ``M`` (``n × nq × nq``),
+        ``h`` and ``Γ`` (``n × nq``), ``nq = nx / 2``. ``t``, ``p`` as for :meth:`rhs_many`."""
+        nq = self._nx[self.mode_index(mode)] // 2
+        out = self._many("DYNAMICS", mode, t, X, p, nq * nq + 2 * nq)
+        return out[:, : nq * nq].reshape(-1, nq, nq), out[:, nq * nq : nq * nq + nq], out[:, nq * nq + nq :]
+
+    def rhs_jacobian_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`rhs_jacobian` at every row of ``X`` in one compiled call: ``f`` (``n × nx``),
+        ``∂f/∂x`` (``n × nx × nx``), ``∂f/∂p`` (``n × nx × len(params)``). ``t``, ``p`` as for
+        :meth:`rhs_many`."""
+        self._need_derivatives()
+        nx = self._nx[self.mode_index(mode)]
+        out = self._many("RHS_JAC", mode, t, X, p, nx + nx * self.sc)
+        J = out[:, nx:].reshape(-1, nx, self.sc)
+        return out[:, :nx], J[:, :, :nx].copy(), J[:, :, self.nx_max : self.nx_max + self._npar].copy()
 
     def walk_batch(self, mode: str | int, x0: np.ndarray, p: np.ndarray, opt: np.ndarray, iopt: np.ndarray,
                    xref: np.ndarray, steps: int, check_every: int, tol: float, threads: int = 1
@@ -378,10 +501,82 @@ def _p(a: np.ndarray) -> Any:
     return a.ctypes.data_as(_dptr)
 
 
+_F64 = np.dtype(np.float64)
+_addressof = ctypes.addressof
+_bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1 byte, else an error
+_frombuffer = np.frombuffer
+_OUT: dict[int, type] = {}
+_NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
+_NO_PARAMS_ADDRESS = _NO_PARAMS.ctypes.data
+
+
+def _out(n: int) -> ctypes.Array:
+    """A fresh zeroed C array of ``n`` doubles: the output of one call, handed to C as it is and
+    returned as an ndarray over the same memory (cheaper than an ndarray's address)."""
+    t = _OUT.get(n)
+    if t is None:
+        t = _OUT[n] = ctypes.c_double * max(n, 1)
+    return t()
+
+
+def address(a: np.ndarray) -> int:
+    """The address of a C-contiguous array's data, several times cheaper than
+    ``a.ctypes.data`` (which builds a helper object per call) for a writable array."""
+    try:
+        return _addressof(_bytes_of(a))
+    except (TypeError, ValueError, BufferError):  # read-only or empty: the general way
+        if not a.flags.c_contiguous:
+            raise StateError("an array handed to compiled code must be C-contiguous") from None
+        return a.ctypes.data
+
+
+def _index(i: Any, n: int) -> int | None:
+    """An integer index in ``0 … n − 1`` (a NumPy integer too), else ``None``."""
+    if isinstance(i, bool):
+        return None
+    try:
+        i = operator.index(i)
+    except TypeError:
+        return None
+    return i if 0 <= i < n else None
+
+
+def _arg(a: Any, n: int, error: type[Exception], what: str) -> tuple[int, np.ndarray]:
+    """The address of ``a`` as ``n`` float64 entries in a row, and the array at that address (it
+    must be kept alive until the call returns). A float64 C-contiguous writable ndarray of shape
+    ``(n,)`` is passed as it is; anything else of ``n`` entries is converted; another size raises
+    ``error`` — before any address reaches C."""
+    if type(a) is np.ndarray and a.dtype is _F64 and a.shape == (n,):
+        try:
+            return _addressof(_bytes_of(a)), a
+        except (TypeError, ValueError, BufferError):  # read-only, not contiguous, or empty
+            pass
+    try:
+        a = np.ascontiguousarray(a, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise error(f"{what} must be {n} real numbers, got {a!r}") from None
+    if a.shape != (n,):
+        raise error(f"{what} has {a.size} entries, expected {n}")
+    return a.ctypes.data, a
+
+
+def _matrix(a: Any, n: int, error: type[Exception], what: str) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array of rows of ``n`` entries (one row: a vector)."""
+    try:
+        a = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise error(f"{what} must be rows of {n} real numbers") from None
+    if a.ndim == 1 and a.shape == (n,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != n:
+        raise error(f"{what} must be rows of {n} entries, got shape {a.shape}")
+    return a
+
+
 def _vec(x: Any, n: int) -> np.ndarray:
     x = np.ascontiguousarray(x, dtype=float).ravel()
     if x.shape != (n,):
-        raise ModelError(f"state has {x.size} entries, expected {n}")
+        raise StateError(f"state has {x.size} entries, expected {n}")
     return x
 
 

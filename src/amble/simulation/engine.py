@@ -18,7 +18,7 @@ import numpy as np
 
 from ..backend import abi
 from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
-from ..backend.kernels import Kernels
+from ..backend.kernels import Kernels, address
 from ..errors import StateError
 
 #: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB. The
@@ -349,8 +349,7 @@ class _Buffers:
                                                                 self.epre, self.epost, self.ne))
 
     def call(self, k: Kernels, p, ctx, opt, iopt, sens: int | None = None) -> int:
-        return int(k.simulate_raw(p.ctypes.data, ctx.ctypes.data, opt.ctypes.data, iopt.ctypes.data,
-                                  *self._addresses, sens))
+        return int(k.simulate_raw(address(p), address(ctx), address(opt), address(iopt), *self._addresses, sens))
 
     def nbytes_grown(self) -> int:
         """Bytes the buffers would hold after :meth:`grow`."""

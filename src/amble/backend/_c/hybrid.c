@@ -117,6 +117,12 @@ int amble_rhs_jacp(int mode, double t, const double *x, const double *p, double 
     return rhs_jacp(mode, t, x, p, J);
 }
 
+/* dx and the whole Jacobian row block [∂f/∂x, ∂f/∂p] (nx rows of SC columns) in one call. */
+int amble_rhs_jac_all(int mode, double t, const double *x, const double *p, double *dx, double *J) {
+    AMBLE_PARAMS(p);
+    return rhs_jac(mode, t, x, p, dx, J) || rhs_jacp(mode, t, x, p, J);
+}
+
 void amble_surfaces_grad(int mode, double t, const double *x, const double *p, double *G) {
     AMBLE_PARAMS(p);
     surfaces_grad(mode, t, x, p, G);
@@ -142,6 +148,28 @@ void amble_rows_kinematics(int64_t nrows, const double *t, const int *mode, cons
     AMBLE_PARAMS(p);
     for (int64_t r = 0; r < nrows; ++r)
         kinematics(mode[r], t[r], x + r * NXMAX, p, pos + r * NPOINTS * 3, vel + r * NPOINTS * 3);
+}
+
+/* Many states per call: the operation op (ROP_*, abi.py) of mode `mode` at each of the n states
+ * x + r * xs, times t[r * ts] and parameters p + r * ps (ps = 0: one vector for all), into
+ * out + r * os. Returns the first row whose kernel failed (a singular mass matrix; the rows after
+ * it are not evaluated), -1 if none, -2 for an unknown op. */
+int64_t amble_rows(int64_t n, int op, int mode, const double *t, int64_t ts, const double *x, int64_t xs,
+                   const double *p, int64_t ps, double *out, int64_t os) {
+    if (op < ROP_RHS || op > ROP_RHS_JAC) return -2;
+    const int nx = MODE_NX[mode], nq = nx / 2;
+    double pf[NPFULL];
+    for (int64_t r = 0; r < n; ++r) {
+        if (r == 0 || ps) amble_k_params(p + r * ps, pf); /* hoisted once per parameter vector */
+        const double *xr = x + r * xs, tr = t[r * ts];
+        double *o = out + r * os;
+        int err = 0;
+        if (op == ROP_RHS) err = rhs(mode, tr, xr, pf, o);
+        else if (op == ROP_DYNAMICS) dynamics(mode, tr, xr, pf, o, o + nq * nq, o + nq * nq + nq);
+        else err = rhs_jac(mode, tr, xr, pf, o, o + nx) || rhs_jacp(mode, tr, xr, pf, o + nx);
+        if (err) return r;
+    }
+    return -1;
 }
 
 void amble_info(int64_t *out) {
