@@ -97,8 +97,8 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     drawn = bool(plot_p or anim_p)
     derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
     s = load_model(args.model, compiled=not drawn, derivatives=derivatives, **robot_options(args))
-    if out_p and any(m.inputs for m in s.modes.values()):
-        s = s.symbolic()  # the inputs written per sample come from the symbolic control law
+    if out_p:
+        s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     t_end, steps = args.time, args.steps
@@ -110,7 +110,11 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
                   sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
     if out_p:
-        write_output(out_p, tr.save, "--out")
+        from ..analysis.trajectory_physics import physics_columns
+
+        # the file holds the physics as well as the states: ground reaction, friction ratio, work
+        extra = physics_columns(tr)
+        write_output(out_p, lambda part: tr.save(part, extra=extra), "--out")
         summary["out"] = str(out_p)
     if plot_p:
         from ..viz.plot import plot_trajectory
