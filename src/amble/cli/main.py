@@ -25,7 +25,7 @@ from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
-from .output import write_output
+from .output import gait_check_lines, write_output
 
 #: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
 MAX_PERIOD = 1000
@@ -201,8 +201,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
                       + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, point)))
         print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
         if "checks" in out:
-            failed = [k for k, v in out["checks"].items() if v is False]
-            print("gait checks: " + ("all passed" if not failed else "FAILED " + ", ".join(failed)))
+            print("\n".join(gait_check_lines(out["checks"], si=unit == "s")))
         for k in ("plot", "animation"):
             if k in out:
                 print(f"wrote {out[k]}")
