@@ -304,6 +304,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     robot_args(e)
     e.add_argument("--latex", action="store_true",
                    help="LaTeX instead of plain text (with --json: LaTeX fields beside the plain ones)")
+    e.add_argument("--standalone", action="store_true",
+                   help="a whole LaTeX document (implies --latex; with --json: the field 'document')")
     e.set_defaults(func=cmd_equations)
     s = add("simulate", "simulate a model for N steps or T seconds")
     model_args(s, Options().rtol)
