@@ -97,7 +97,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     drawn = bool(plot_p or anim_p)
     derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
     s = load_model(args.model, compiled=not drawn, derivatives=derivatives, **robot_options(args))
-    if out_p:
+    if out_p and (any(m.inputs for m in s.modes.values()) or getattr(s, "hip", None) is not None):
         s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
