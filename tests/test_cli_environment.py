@@ -55,7 +55,7 @@ def _no_space(path: Path) -> None:
 
 def test_a_full_disk_is_one_line_and_leaves_no_partial_file(capsys, tmp_path, monkeypatch):
     # once an internal error (OSError 28) with the truncated file left behind
-    monkeypatch.setattr(Trajectory, "save", lambda self, path: _no_space(Path(path)))
+    monkeypatch.setattr(Trajectory, "save", lambda self, path, **kw: _no_space(Path(path)))
     out = tmp_path / "walk.csv"
     _error(capsys, ["simulate", "compass-gait", "--steps", "2", "--out", str(out)], "No space left on device")
     assert list(tmp_path.iterdir()) == []

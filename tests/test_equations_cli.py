@@ -32,7 +32,7 @@ def run(capsys, *args):
 def test_text_shows_guard_and_derived_impact_map(capsys):
     code, out, _ = run(capsys, "equations", "compass-gait")
     assert code == 0
-    assert "guard: a*cos(slope - stance)" in out and "falling through 0" in out
+    assert "guard: (-a - b)*cos(slope - swing) + (a + b)*cos(slope - stance)" in out and "falling through 0" in out
     assert "impact of swing_foot: M_e (qd_e+ - qd_e-) = J^T lambda" in out
     assert "qd_e = (stance_dot, swing_dot, base_x_dot, base_y_dot)" in out
     assert "M_e[2] = [(a*m + a*mh + 2*b*m + b*mh)*cos(stance), -a*m*cos(swing), 2*m + mh, 0]" in out

@@ -31,9 +31,10 @@ def pendulum():
     return amble.simulate(system, t_end=1.0)
 
 
-def test_plain_system_has_no_ground_and_no_step_label(pendulum, compass):
+def test_plain_system_has_a_level_floor_below_it_and_no_step_label(pendulum, compass):
     scene = scene_of(pendulum, fps=30)
-    assert not [s for s in scene["shapes"] if s["type"] == "ground"]
+    (floor,) = [s for s in scene["shapes"] if s["type"] == "ground"]
+    assert floor["slope"] == 0 and floor["height"] < -0.9  # below the bob, which hangs 1 m down
     assert "step" not in scene.get("labels", {})
     walk = scene_of(amble.simulate(compass, steps=2), fps=30)
     assert [s for s in walk["shapes"] if s["type"] == "ground"] and "step" in walk["labels"]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import threading
+import warnings
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -70,7 +71,11 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
             raise SchedulerError(f"cannot connect to the Dask scheduler at {scheduler!r} ({e})") from None
         return client, client.close
     n = workers_for(workers)
-    with _children_ignore_sigint():
+    with _children_ignore_sigint(), warnings.catch_warnings():
+        # without a dashboard the scheduler still binds an HTTP server (health, metrics) to the
+        # dashboard's default port, and warns when another program holds it; nobody reads that
+        # server here, so another port is as good and the warning is not the user's business
+        warnings.filterwarnings("ignore", message=r"Port \d+ is already in use", category=UserWarning)
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
     client = Client(cluster)
     client.register_plugin(_quiet_cancels_plugin()())  # sent by value (cloudpickle)

@@ -27,7 +27,7 @@ from .gaits import EXAMPLE as GAITS_EXAMPLE
 from .gaits import add_parser as add_gaits_parser
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
-from .output import write_output
+from .output import gait_check_lines, write_output
 
 #: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
 MAX_PERIOD = 1000
@@ -99,8 +99,8 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     drawn = bool(plot_p or anim_p)
     derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
     s = load_model(args.model, compiled=not drawn, derivatives=derivatives, **robot_options(args))
-    if out_p and any(m.inputs for m in s.modes.values()):
-        s = s.symbolic()  # the inputs written per sample come from the symbolic control law
+    if out_p and (any(m.inputs for m in s.modes.values()) or getattr(s, "hip", None) is not None):
+        s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
     params = parse_sets(args.set)
     x0 = _start(s, args.start, params)
     t_end, steps = args.time, args.steps
@@ -112,7 +112,11 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
                   sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
     if out_p:
-        write_output(out_p, tr.save, "--out")
+        from ..analysis.trajectory_physics import physics_columns
+
+        # the file holds the physics as well as the states: ground reaction, friction ratio, work
+        extra = physics_columns(tr)
+        write_output(out_p, lambda part: tr.save(part, extra=extra), "--out")
         summary["out"] = str(out_p)
     if plot_p:
         from ..viz.plot import plot_trajectory
@@ -199,8 +203,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
                       + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, point)))
         print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
         if "checks" in out:
-            failed = [k for k, v in out["checks"].items() if v is False]
-            print("gait checks: " + ("all passed" if not failed else "FAILED " + ", ".join(failed)))
+            print("\n".join(gait_check_lines(out["checks"], si=unit == "s")))
         for k in ("plot", "animation"):
             if k in out:
                 print(f"wrote {out[k]}")
@@ -304,6 +307,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     robot_args(e)
     e.add_argument("--latex", action="store_true",
                    help="LaTeX instead of plain text (with --json: LaTeX fields beside the plain ones)")
+    e.add_argument("--standalone", action="store_true",
+                   help="a whole LaTeX document (implies --latex; with --json: the field 'document')")
     e.set_defaults(func=cmd_equations)
     s = add("simulate", "simulate a model for N steps or T seconds")
     model_args(s, Options().rtol)

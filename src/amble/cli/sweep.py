@@ -22,7 +22,7 @@ from ..analysis.doubling import period_doubling
 from ..analysis.sweep import sweep
 from ..simulation.engine import Options
 from .args import UsageError, check_grid_size, load_model, parse_range, parse_sets, robot_options, writable_path
-from .output import write_output
+from .output import number, write_output
 
 
 def sweep_cli(args: Any) -> dict[str, Any]:
@@ -208,9 +208,13 @@ def _print(summary: dict[str, Any], out: Any, plot: Any) -> None:
     else:
         print(f"{summary['model']}: {summary['kind']} sweep over {' × '.join(summary['parameters'])}: "
               f"{summary['points']} points, {summary['ok']} ok, {summary['failed']} failed ({summary['seconds']} s)")
+    p0 = summary["parameters"][0] if summary.get("parameters") else ""
     for key in ("period_doubling", "stable_range", "first_period_two"):
-        if key in summary:
-            print(f"  {key.replace('_', ' ')}: {summary[key]}")
+        v = summary.get(key)
+        if v is None:  # absent or not found: a line saying "None" tells nothing
+            continue
+        shown = " → ".join(number(x, 6) for x in v) if isinstance(v, (list, tuple)) else number(v, 8)
+        print(f"  {key.replace('_', ' ')}: {p0 + ' = ' if p0 else ''}{shown}")
     p = summary["parameters"][0] if summary.get("parameters") else ""
     for b in summary.get("branches", []):
         print(f"  branch {b['branch']}: period {b['period']}, {p} {b['range'][0]:.6g} → {b['range'][1]:.6g}, "

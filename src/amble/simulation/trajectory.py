@@ -9,7 +9,7 @@ accumulates the footholds so a walk can be drawn on its slope.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -237,9 +237,11 @@ class Trajectory:
             return "W" if self.system.time_unit == "s" else ""
         return self.system.unit(name) if self.system is not None else ""
 
-    def table(self) -> dict[str, np.ndarray]:
+    def table(self, extra: Mapping[str, tuple[np.ndarray, str]] | None = None) -> dict[str, np.ndarray]:
         """Columns: ``t``, ``mode``, every state variable of every mode (NaN where absent), the
-        energies, then every input ``u`` and its power ``power_<input>`` (W)."""
+        energies, then every input ``u`` and its power ``power_<input>`` (W), then the ``extra``
+        columns (name → (values per sample, unit); e.g. the ground reaction of
+        :func:`amble.analysis.trajectory_physics.physics_columns`)."""
         cols: dict[str, np.ndarray] = {"t": self.t, "mode": np.array([self.mode_names[m] for m in self.mode])}
         for m in self.mode_names:
             for name in self.state_names(m):
@@ -251,18 +253,27 @@ class Trajectory:
             u, power = self.inputs(), self.joint_power()
             cols.update(u)
             cols.update({f"power_{k}": v for k, v in power.items()})
+        for name, (values, _) in (extra or {}).items():
+            if name in cols:
+                raise AmbleError(f"extra column {name!r} would replace a column of the trajectory")
+            values = np.asarray(values)
+            if values.shape != self.t.shape:
+                raise AmbleError(f"extra column {name!r} has {values.shape} values for {len(self.t)} samples")
+            cols[name] = values
         return cols
 
-    def save(self, path: str | Path) -> Path:
-        """Write the samples to ``.csv``, ``.parquet`` or ``.npz`` (chosen by suffix).
+    def save(self, path: str | Path, extra: Mapping[str, tuple[np.ndarray, str]] | None = None) -> Path:
+        """Write the samples (:meth:`table`, with the ``extra`` columns) to ``.csv``, ``.parquet``
+        or ``.npz`` (chosen by suffix).
 
         A CSV ends with an ``event`` column: ``NAME:pre`` and ``NAME:post`` on the two rows of
         transition ``NAME``. Units travel with the columns: CSV headers read ``name [unit]``,
         Parquet fields carry a ``unit`` metadata entry, an ``.npz`` holds ``units`` (one
         per column, in order)."""
         path = Path(path)
-        cols = self.table()
-        units = [self.unit(c) for c in cols]
+        cols = self.table(extra)
+        extra_units = {k: u for k, (_, u) in (extra or {}).items()}
+        units = [extra_units[c] if c in extra_units else self.unit(c) for c in cols]
         suffix = path.suffix.lower()
         if suffix == ".npz":
             ev = {

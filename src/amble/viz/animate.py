@@ -46,6 +46,16 @@ def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] 
     return out
 
 
+def floor_under(shapes: Sequence[Any], points: dict[str, np.ndarray]) -> Ground:
+    """A level floor for a robot that declares no ground (a fixed-base arm, a falling robot): at
+    the lowest point the drawing reaches over the run — the lowest point less the radius of its
+    sphere, if it has one — and wide enough for the robot's lateral reach (m)."""
+    radius = {s.at: s.radius for s in shapes if isinstance(s, Sphere)}
+    low = min(float(np.min(v[:, 2])) - radius.get(n, 0.0) for n, v in points.items())
+    reach = max(float(np.max(np.abs(v[:, 1]))) + radius.get(n, 0.0) for n, v in points.items())
+    return Ground(slope=0.0, height=low, width=max(2.0, 2.0 * reach + 1.0))
+
+
 def _slope(system: HybridSystem, params: dict[str, float]) -> float:
     return system.slope_value(params) if isinstance(system, Walker) else 0.0
 
@@ -81,6 +91,8 @@ def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = N
     follow = hip if hip in pts else None
     used = {n for s in shapes for n in s.points()}
     pts = {n: np.nan_to_num(v) for n, v in pts.items() if n in used or n == follow}
+    if not any(isinstance(s, Ground) for s in shapes) and pts:
+        shapes = [floor_under(shapes, pts), *shapes]
     labels = {}
     if walker:  # a step count means something for a walker only
         labels["step"] = np.searchsorted([e.t for e in traj.step_events], times, side="right").tolist()

@@ -80,9 +80,14 @@ def frames(
 
     arrays = {name: _as_xyz(name, points[name], n) for name in needed}
 
+    size = 0.0
     if arrays:
         stacked = np.concatenate(list(arrays.values()), axis=0)
         lo, hi = stacked.min(axis=0), stacked.max(axis=0)
+        # the robot's own size: the largest diagonal of its bounding box in any one frame (the
+        # camera's distance; the bounds of the whole run are the walk's, not the robot's)
+        per_frame = np.stack(list(arrays.values()), axis=0)  # (points, frames, 3)
+        size = float(np.max(np.linalg.norm(per_frame.max(axis=0) - per_frame.min(axis=0), axis=1)))
     else:
         static = [s.center for s in shapes if isinstance(s, Box)]
         lo = np.min(static, axis=0) if static else np.zeros(3)
@@ -104,6 +109,7 @@ def frames(
         "labels": _labels(labels, n),
         **({"series": _series(series, n)} if series else {}),
         "bounds": {"min": _flat(lo), "max": _flat(hi)},
+        "size": rounded(size),
     }
     return scene
 

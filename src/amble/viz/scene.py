@@ -10,8 +10,8 @@ Conventions
 * Units: metres, radians, seconds. Colours are sRGB triples of floats in 0..1.
 * World frame: x forward (the downhill walking direction), y lateral (left),
   z up. Planar (2D) models live in the x-z plane, y = 0.
-* The walking surface (:class:`Ground`) is a plane through the world origin
-  that descends along +x by the angle ``slope``: ``z = -x * tan(slope)``.
+* The walking surface (:class:`Ground`) is a plane through ``(0, 0, height)``
+  that descends along +x by the angle ``slope``: ``z = height - x * tan(slope)``.
 
 Scene format (``"format": "amble.scene/1"``)
 --------------------------------------------
@@ -27,11 +27,13 @@ Scene format (``"format": "amble.scene/1"``)
         {"type": "box",      "center": "hip" | [x, y, z], "size": [sx, sy, sz],
                              "rotation": [rx, ry, rz], "color": ..., "opacity": a},
         {"type": "ground",   "slope": s, "width": w, "grid": g, "extent": [s0, s1],
-                             "color": ..., "opacity": a}
+                             "color": ..., "opacity": a, "height": z0}   # height: if not 0
       ],
       "follow": "hip" | null,                   # point the camera may track
       "labels": {"step": [0, 0, 1, ...]},        # F values per label (numbers or strings)
-      "bounds": {"min": [x, y, z], "max": [x, y, z]}  # over all exported points and frames
+      "bounds": {"min": [x, y, z], "max": [x, y, z]}, # over all exported points and frames
+      "size": d                                 # the robot's extent: largest bounding-box
+                                                # diagonal of one frame, metres
     }
 
 Only points referenced by a shape (or by ``follow``) are exported. Numbers are

@@ -76,6 +76,13 @@ def _opacity(value: float, what: str, owner: str) -> float:
     return a
 
 
+def _finite(value: float, what: str, owner: str) -> float:
+    v = float(value)
+    if not math.isfinite(v):
+        raise SceneError(f"{owner}: {what} must be a finite number, got {value!r}")
+    return v
+
+
 def _positive(value: float, what: str, owner: str) -> float:
     v = float(value)
     if not (math.isfinite(v) and v > 0.0):
@@ -230,6 +237,8 @@ class Ground(_Shape):
         color: sRGB colour, floats in 0..1.
         opacity: 1 is opaque, 0 is invisible (the grid stays visible).
         grid: spacing of the grid lines in metres, measured along the surface.
+        height: the plane's height at x = 0, metres (``z = height - x tan(slope)``): a robot
+            that is no walker stands on a floor at the lowest point it reaches.
     """
 
     kind: ClassVar[str] = "ground"
@@ -238,14 +247,18 @@ class Ground(_Shape):
     color: Color = _field(_color, GROUND_COLOR)
     opacity: float = _field(_opacity, 1.0)
     grid: float = _field(_positive, 0.1)
+    height: float = _field(_finite, 0.0)
 
     def to_dict(self, extent: tuple[float, float] = (-5.0, 5.0)) -> dict[str, Any]:
-        """Static properties in the scene format.
+        """Static properties in the scene format (``height`` only when not 0).
 
         Args:
             extent: range of the along-slope coordinate covered, metres.
         """
-        return {**super().to_dict(), "extent": [rounded(extent[0]), rounded(extent[1])]}
+        out = {**super().to_dict(), "extent": [rounded(extent[0]), rounded(extent[1])]}
+        if out.get("height") == 0:
+            out.pop("height")
+        return out
 
 
 #: Anything :func:`amble.viz.scene.frames` can draw.

@@ -144,10 +144,46 @@ def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | Non
     if ni > 1 and nj > 1 and np.isfinite(M).any():
         ax.contour(bv, av, M, levels=[1.0], colors="w", linewidths=1.5)
     fig.colorbar(im, ax=ax, label="largest multiplier modulus |λ| (1)")
+    branched = _mark_branches(ax, result.rows, a, b)
     ax.set_xlabel(_label(b))
     ax.set_ylabel(_label(a))
-    ax.set_title(title or "Stability map (white: |λ| = 1; grey: no fixed point)")
+    ax.set_title(title or "Stability map (white: |λ| = 1; grey: no fixed point"
+                 + ("; marked: another branch)" if branched else ")"))
     return _save(fig, path)
+
+
+def _branch_id(row: Any) -> str | None:
+    """A row's branch id as text, ``None`` when the sweep does not record one (older files, or
+    sweeps that follow a single branch)."""
+    try:
+        v = row["branch"]
+    except (KeyError, IndexError, TypeError):
+        return None
+    if v is None or (isinstance(v, float) and not np.isfinite(v)) or str(v).strip() in ("", "nan", "None"):
+        return None
+    try:
+        return str(int(float(v)))
+    except (TypeError, ValueError):
+        return str(v)
+
+
+def _mark_branches(ax: Any, rows: Any, a: str, b: str) -> bool:
+    """Mark the cells whose fixed point lies on another branch than most of the map's: a colour
+    alone cannot tell two gaits of similar stability apart. Returns whether any cell was marked."""
+    ids = [(_branch_id(r), r) for r in rows if r["status"] == "ok"]
+    ids = [(k, r) for k, r in ids if k is not None]
+    if not ids:
+        return False
+    values, counts = np.unique([k for k, _ in ids], return_counts=True)
+    if len(values) < 2:
+        return False
+    main = values[int(np.argmax(counts))]
+    for n, k in enumerate(v for v in values if v != main):
+        pts = np.array([(float(r[b]), float(r[a])) for kk, r in ids if kk == k])
+        ax.scatter(pts[:, 0], pts[:, 1], marker="x", s=28, color=f"C{(n + 1) % 10}", linewidths=1.2,
+                   label=f"branch {k}", gid="branch_change")
+    ax.legend(fontsize=7, loc="upper right", title=f"most cells: branch {main}", title_fontsize=7)
+    return True
 
 
 def plot_continuation(result: Any, path: str | os.PathLike, *, coordinate: str | None = None,

@@ -53,7 +53,8 @@
 
   function addGround(g) {
     const group = new THREE.Group();
-    group.rotation.y = g.slope;             // local x runs downhill: z = -x tan(slope)
+    group.rotation.y = g.slope;             // local x runs downhill: z = height - x tan(slope)
+    group.position.z = g.height || 0;       // a floor under a robot that is no walker
     const s0 = g.extent[0], s1 = g.extent[1], w = g.width, step = g.grid;
     const plane = new THREE.Mesh(new THREE.PlaneGeometry(s1 - s0, w),
       material(g, { roughness: 0.95, metalness: 0, polygonOffset: true,
@@ -122,7 +123,9 @@
   const first = locate(t0);
   for (const n of names) { pointAt(n, first, va); lo0.min(va); hi0.max(va); }
   if (!names.length) { lo0.set(-0.5, -0.5, 0); hi0.set(0.5, 0.5, 1); }
-  const robotSize = Math.max(0.5, hi0.clone().sub(lo0).length());
+  // The robot's extent over the whole run (a robot that falls or swings its arms up needs
+  // more room than its first pose shows); older scenes without it: the first frame's.
+  const robotSize = Math.max(0.5, data.size || hi0.clone().sub(lo0).length());
   const center = new THREE.Vector3();
   const followHeight = follow
     ? pointAt(follow, first, va).z + va.x * tanSlope : 0;   // height above the ground
