@@ -230,8 +230,10 @@ def follow(P: ReturnMap, x: np.ndarray, p0: np.ndarray, p1: np.ndarray, *, tol: 
             continue
         tn = _null(Jn, t)
         if tn[-1] * t[-1] < 0 and not end:
-            raise ConvergenceError(f"the branch folds at {path.where(float(un[-1]), names)} ({un[-1]:.0%} of the "
-                                   f"way); no gait beyond on this branch; {last()}")
+            # s turns back between the two gaits: the fold lies at or beyond the larger s
+            fold = max(float(u[-1]), float(un[-1]))
+            raise ConvergenceError(f"the branch folds at {path.where(fold, names)} ({fold:.0%} of the way); no gait "
+                                   f"beyond on this branch; {last()}")
         u, J, T, dT, t, mult = un, Jn, Tn, dTn, tn, multn
         if end:
             P.p = path.params(1.0)
