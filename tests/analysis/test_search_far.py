@@ -88,3 +88,19 @@ def test_a_fold_is_reported_with_where_it_folds():
     # no gait of that branch below it, and the message says so
     with pytest.raises(ConvergenceError, match=r"folds at slope = 0\.045152.*no gait beyond on this branch"):
         find_fixed_point(load("kneed-biped"), params={"slope": 0.03})
+
+
+def test_a_sweep_keeps_its_branch_and_says_where_it_ends():
+    import amble
+
+    res = amble.sweep(load("kneed-biped"), "fixed-point", {"slope": np.linspace(0.044, 0.07, 6)},
+                      scheduler="synchronous", progress=False)
+    rows = sorted(res.rows, key=lambda r: float(r["slope"]))
+    # below the fold at 0.0451521 there is no gait on the branch, and the row says why
+    assert rows[0]["status"] == "failed" and "folds at slope = 0.04515" in rows[0]["reason"]
+    ok = [r for r in rows if r["status"] == "ok"]
+    assert len(ok) == 5 and len({r["branch"] for r in ok}) == 1
+    assert all(r["seeded"] == "true" and r["branch_break"] == "" for r in ok[1:])
+    # one branch: its step time changes smoothly (a jump to the unstable cycle would change it by ~20 %)
+    T = np.array([float(r["step_time"]) for r in ok])
+    assert np.all(np.diff(T) > 0) and np.max(np.abs(np.diff(T, 2))) < 0.01

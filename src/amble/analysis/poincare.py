@@ -261,6 +261,24 @@ def find_fixed_point(
     return followed if followed.stable or direct is None else direct
 
 
+def continue_fixed_point(system: HybridSystem, x: Sequence[float], from_params: Mapping[str, float],
+                         params: Mapping[str, float], *, period: int = 1, rtol: float = FIXED_POINT_TOL,
+                         atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL, max_iter: int = 40) -> LimitCycle:
+    """The gait ``x`` (a fixed point at ``from_params``) carried to ``params`` along its branch
+    (:func:`amble.analysis.homotopy.follow`: tangent predictor from the exact parameter
+    derivatives, step control, branch jumps refused). :class:`ConvergenceError` says in one line
+    why the branch ends (it folds, the walker falls, it is lost) with the last gait on it."""
+    from .homotopy import follow
+
+    P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
+    Q = ReturnMap(system, from_params, period=period, rtol=rtol, atol=atol, mode=P.mode)
+    try:
+        xe = follow(Q, np.asarray(x, float), Q.p.copy(), P.p.copy(), tol=tol)
+    except SimulationError as e:
+        raise ConvergenceError(f"lost the branch: {e}") from None
+    return _newton(system, P, xe, period, tol, max_iter)
+
+
 def _scaled_start(system: HybridSystem, P: ReturnMap) -> np.ndarray | None:
     """The model's guess with its velocities rescaled to the requested value of a parameter that
     only rescales time (a passive walker's gravity), when there is one; else ``None``."""
@@ -301,7 +319,8 @@ def _from_defaults(system: HybridSystem, P: ReturnMap, **kw: Any) -> LimitCycle:
         p0[sc[0]] = p1[sc[0]]
         x = sc[1]
     errors = []
-    for geometric in (False, True):
+    # with one parameter moving, the geometric path is the straight one run at another pace
+    for geometric in (False, True) if int(np.sum(p0 != p1)) > 1 else (False,):
         try:
             xe = follow(Q, x, p0, p1, tol=kw["tol"], geometric=geometric)
             return _newton(system, P, xe, P.period, kw["tol"], kw["max_iter"], kw["jacobian"])
