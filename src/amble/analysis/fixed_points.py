@@ -124,15 +124,20 @@ def fixed_point_kind(system: HybridSystem, over: Mapping[str, np.ndarray], param
     at every value of one parameter (a branch), or on the grid of two (a map).
 
     One parameter: each chunk of ``chunk`` (default 32) consecutive values is one Dask task; inside
-    it the fixed point at one value is the Newton guess at the next (``warm_start=False``: every
-    point from the model's guess). A point that does not converge is recorded ``failed`` with its
-    reason and the next point is seeded from the last converged one (then from the model's guess).
+    it the gait at one value is continued along its branch to the next (``warm_start=False``:
+    every point from the model's guess). A point the branch does not reach is searched from the
+    model's guess and, if found, starts a new branch; one with no gait is recorded ``failed`` with
+    the reason (the branch folds, the walker fell, the branch was lost), and the next point is
+    continued from the last converged one.
     Two parameters ``{a: …, b: …}``: one task per value of ``a`` (``i``), warm-started along ``b``
     (``j``); ``chunk`` does not apply. ``tol``: the residual ``|P(x) − x|∞`` of a fixed point.
     Rows: ``i`` (index of the first parameter's value), ``j`` (of the second; 0 for a branch), the
     parameter values, ``status``, ``reason``, fixed point ``x_<state>``, ``step_time`` (s),
     multipliers (JSON ``[[re, im], ...]``) and their moduli, ``max_modulus``, ``stable``,
-    ``residual``, ``seeded``. ``SweepResult.kind``: ``fixed-point`` or ``fixed-point-map``.
+    ``residual``, ``seeded`` (continued from the point before), ``branch`` (the grid index of the
+    point where its branch was first found) and ``branch_break`` (why the branch of the point
+    before did not reach this one; empty when it did). ``SweepResult.kind``: ``fixed-point`` or
+    ``fixed-point-map``.
     """
     fp_kw = {"rtol": run.rtol, "atol": run.atol, "tol": tol}
     names = list(over)
