@@ -34,15 +34,15 @@ Units: states in the model's units (rad, rad/s), times in s, parameters in their
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from ..errors import ConvergenceError, SimulationError
 from .section import Section
 
-if TYPE_CHECKING:
-    from .poincare import ReturnMap
+#: ``P`` below: a :class:`amble.analysis.poincare.ReturnMap` (not imported: poincare calls this module).
+ReturnMap = Any
 
 #: A corrected point may lie at most this fraction of the step from its prediction.
 JUMP_FRACTION = 0.3
