@@ -249,15 +249,16 @@ def find_fixed_point(
     except (SimulationError, ConvergenceError) as e:
         if guess is not None or not params or at_defaults:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
-        direct = None
+        direct, direct_error = None, str(e).splitlines()[0] if str(e) else type(e).__name__
     if direct is not None and (direct.stable or guess is not None or at_defaults):
         return direct
     try:
         followed = _from_defaults(system, P, period=period, tol=tol, max_iter=max_iter, jacobian=jacobian)
-    except ConvergenceError:
+    except ConvergenceError as e:
         if direct is not None:
             return direct
-        raise
+        # both searches say why they failed (e.g. the walk at these parameters ends at rest)
+        raise ConvergenceError(f"{e}; from a walk at these parameters: {direct_error}") from None
     return followed if followed.stable or direct is None else direct
 
 
