@@ -107,3 +107,16 @@ def test_period_two_search_that_finds_period_one_says_so(capsys):
     code, out, _ = run(capsys, "limit-cycle", "compass-gait", "--period", "2", "--json")
     d = json.loads(out)
     assert d["period"] == 1 and d["requested_period"] == 2
+
+
+def test_limit_cycle_tol_bounds_the_residual(capsys):
+    # the default stops tighter than the promised 1e-10 accuracy of the fixed point; --tol loosens it
+    code, out, _ = run(capsys, "limit-cycle", "round-foot-walker", "--json")
+    assert code == 0 and json.loads(out)["residual"] < 1e-12
+    code, out, _ = run(capsys, "limit-cycle", "round-foot-walker", "--tol", "1e-6", "--json")
+    assert code == 0 and json.loads(out)["residual"] < 1e-6
+    code, _, err = run(capsys, "limit-cycle", "round-foot-walker", "--tol", "0")
+    assert code == 2 and "--tol" in err
+    code, _, err = run(capsys, "sweep", "compass-gait", "--kind", "bifurcation", "--param", "slope=0.01:0.02:2",
+                       "--tol", "1e-9")
+    assert code == 2 and "--tol applies to" in err

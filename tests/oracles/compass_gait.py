@@ -22,22 +22,29 @@ L = A + B
 RTOL = ATOL = 1e-12
 
 
-def rhs(_t: float, x: np.ndarray) -> np.ndarray:
+#: (m, mH, a, b, g): the leg mass and hip mass (kg), the leg's mass from the foot and from the hip
+#: (m), gravity (m/s²); every function takes another such tuple as ``par``.
+DEFAULT = (M_LEG, M_HIP, A, B, G)
+
+
+def rhs(_t: float, x: np.ndarray, par: tuple = DEFAULT) -> np.ndarray:
     """M(q) q'' + N(q, q') q' + g(q) = 0."""
     ns, s, dns, ds = x
-    m, mh, a, b, l = M_LEG, M_HIP, A, B, L
+    m, mh, a, b, g = par
+    l = a + b
     c, sn = math.cos(s - ns), math.sin(s - ns)
     M = np.array([[m * b * b, -m * l * b * c], [-m * l * b * c, (mh + m) * l * l + m * a * a]])
     N = np.array([[0.0, m * l * b * sn * ds], [-m * l * b * sn * dns, 0.0]])
-    grav = G * np.array([m * b * math.sin(ns), -(mh * l + m * a + m * l) * math.sin(s)])
+    grav = g * np.array([m * b * math.sin(ns), -(mh * l + m * a + m * l) * math.sin(s)])
     qdd = np.linalg.solve(M, -N @ np.array([dns, ds]) - grav)
     return np.array([dns, ds, qdd[0], qdd[1]])
 
 
-def impact(x: np.ndarray) -> np.ndarray:
+def impact(x: np.ndarray, par: tuple = DEFAULT) -> np.ndarray:
     """Q+(alpha) q'+ = Q-(alpha) q'-, q+ = J q- (the legs swap), 2 alpha = th_ns- - th_s-."""
     ns, s, dns, ds = x
-    m, mh, a, b, l = M_LEG, M_HIP, A, B, L
+    m, mh, a, b, _ = par
+    l = a + b
     c2 = math.cos(ns - s)
     qm = np.array([[-m * a * b, -m * a * b + (mh * l * l + 2 * m * a * l) * c2], [0.0, -m * a * b]])
     qp = np.array([[m * b * (b - l * c2), m * l * (l - b * c2) + m * a * a + mh * l * l], [m * b * b, -m * b * l * c2]])
@@ -45,21 +52,22 @@ def impact(x: np.ndarray) -> np.ndarray:
     return np.array([s, ns, v[0], v[1]])
 
 
-def step(x: np.ndarray, phi: float) -> tuple[np.ndarray, float]:
+def step(x: np.ndarray, phi: float, par: tuple = DEFAULT) -> tuple[np.ndarray, float]:
     """Post-impact state to the next post-impact state, and the step time. Heel strike:
     th_ns + th_s = -2 phi with the swing leg in front (th_ns > th_s), crossed downward; the
     first 0.1 s (the guard is 0 at the start and the swing foot scuffs near mid-stance) is
     integrated without it."""
-    early = solve_ivp(rhs, (0.0, 0.1), x, method="DOP853", rtol=RTOL, atol=ATOL)
+    early = solve_ivp(rhs, (0.0, 0.1), x, method="DOP853", rtol=RTOL, atol=ATOL, args=(par,))
 
-    def strike(_t, y):
+    def strike(_t, y, _par):
         return y[0] + y[1] + 2 * phi
 
     strike.terminal, strike.direction = True, -1
-    sol = solve_ivp(rhs, (0.1, 5.0), early.y[:, -1], method="DOP853", rtol=RTOL, atol=ATOL, events=strike)
+    sol = solve_ivp(rhs, (0.1, 5.0), early.y[:, -1], method="DOP853", rtol=RTOL, atol=ATOL, events=strike,
+                    args=(par,))
     (te,), (xe,) = sol.t_events[0], sol.y_events[0]
     assert xe[0] > xe[1], "the swing leg must be in front at heel strike"
-    return impact(xe), float(te)
+    return impact(xe, par), float(te)
 
 
 def _full(z: np.ndarray, phi: float) -> np.ndarray:
@@ -67,26 +75,43 @@ def _full(z: np.ndarray, phi: float) -> np.ndarray:
     return np.array([-2 * phi - z[0], z[0], z[1], z[2]])
 
 
-def _map(z: np.ndarray, phi: float) -> np.ndarray:
-    x, _ = step(_full(z, phi), phi)
+def _map(z: np.ndarray, phi: float, par: tuple = DEFAULT) -> np.ndarray:
+    x, _ = step(_full(z, phi), phi, par)
     return x[1:]
 
 
-def _jacobian(z: np.ndarray, phi: float, h: float = 1e-6) -> np.ndarray:
-    return np.column_stack([(_map(z + h * e, phi) - _map(z - h * e, phi)) / (2 * h) for e in np.eye(3)])
+def _jacobian(z: np.ndarray, phi: float, h: float = 1e-6, par: tuple = DEFAULT) -> np.ndarray:
+    return np.column_stack([(_map(z + h * e, phi, par) - _map(z - h * e, phi, par)) / (2 * h) for e in np.eye(3)])
 
 
-def fixed_point(phi: float, z0=(0.2187, -0.377, -1.092)) -> tuple[np.ndarray, np.ndarray]:
+def fixed_point(phi: float, z0=(0.2187, -0.377, -1.092), par: tuple = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
     """Post-impact fixed point [th_ns, th_s, dth_ns, dth_s] on slope phi (rad), by Newton with a
-    central-difference Jacobian, and the Jacobian of the 3-D section map there."""
+    central-difference Jacobian, and the Jacobian of the 3-D section map there; ``par`` as
+    :data:`DEFAULT`."""
     z = np.asarray(z0, float)
     for _ in range(20):
-        jac = _jacobian(z, phi)
-        dz = np.linalg.solve(jac - np.eye(3), -(_map(z, phi) - z))
+        jac = _jacobian(z, phi, par=par)
+        dz = np.linalg.solve(jac - np.eye(3), -(_map(z, phi, par) - z))
         z = z + dz
         if np.max(np.abs(dz)) < 1e-11:
             break
-    return _full(z, phi), _jacobian(z, phi)
+    return _full(z, phi), _jacobian(z, phi, par=par)
+
+
+def follow(phi: float, par: tuple, stages: int = 8, z0=(0.2187, -0.377, -1.092), phi0: float = 0.05
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """The fixed point at (phi, par) by natural-parameter continuation from Goswami's walker at
+    slope phi0 (the guess ``z0`` lies near its gait): all of (phi, m, mH, a, b, g) move linearly
+    in ``stages`` stages, each Newton's guess extrapolated from the last two gaits (secant)."""
+    start = np.array([*DEFAULT, phi0])
+    end = np.array([*par, phi])
+    zs = [np.asarray(z0, float)]
+    for k in range(1, stages + 1):
+        v = start + (end - start) * k / stages
+        guess = 2 * zs[-1] - zs[-2] if len(zs) > 1 else zs[-1]
+        x, jac = fixed_point(v[-1], guess, tuple(v[:-1]))
+        zs.append(x[1:])
+    return x, jac
 
 
 def multipliers(phi: float) -> np.ndarray:

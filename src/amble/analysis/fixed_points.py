@@ -33,41 +33,72 @@ if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, with
 def _fp_columns(pnames: Sequence[str], snames: Sequence[str]) -> dict[str, str]:
     return {"i": "int", "j": "int", **dict.fromkeys(pnames, "float"), "status": "str", "reason": "str",
             **dict.fromkeys(state_columns(snames), "float"), "step_time": "float", "max_modulus": "float",
-            "moduli": "json", "multipliers": "json", "stable": "bool", "residual": "float", "seeded": "bool"}
+            "moduli": "json", "multipliers": "json", "stable": "bool", "residual": "float", "seeded": "bool",
+            "branch": "int", "branch_break": "str"}
+
+
+def _first_line(e: Exception) -> str:
+    return f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
 
 
 def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], points: list[tuple[int, int, tuple]],
-             seed: list[float] | None, kw: dict[str, Any]) -> list[dict[str, Any]]:
-    """Continuation along one chunk: each converged fixed point seeds the next point."""
-    from .poincare import find_fixed_point
+             seed: tuple[list[float], dict[str, float], int] | None, kw: dict[str, Any],
+             flat: list[int] | None = None) -> list[dict[str, Any]]:
+    """One chunk: each point continued from the last gait before it (its neighbour) along the
+    branch (:func:`continue_fixed_point`: predictor, step control, branch jumps refused), keeping
+    that gait's branch id; a point that cannot be continued is searched afresh from the model's
+    guess and, if found, starts a new branch (id: its index in the grid), with ``branch_break``
+    saying why the old branch did not reach it. ``seed``: (gait, its parameters, its branch)."""
+    from .poincare import continue_fixed_point, find_fixed_point
 
     snames = compiled(system).meta["state_names"][compiled(system).meta["modes"][0]]
-    guess = None if seed is None else np.asarray(seed, float)
+    prev = None if seed is None else (np.asarray(seed[0], float), dict(seed[1]), int(seed[2]))
     out = []
-    for i, j, vals in points:
+    for n, (i, j, vals) in enumerate(points):
         params = {**base, **dict(zip(pnames, vals))}
         row: dict[str, Any] = {"i": i, "j": j, **dict(zip(pnames, vals))}
-        lc, reason, seeded = None, "", guess is not None
-        attempts = [guess, None] if guess is not None else [None]
-        for g in attempts:  # a lost branch is retried from the model's own guess
+        lc, broke, reason, branch = None, "", "", -1
+        if prev is not None:
             try:
-                lc = find_fixed_point(system, g, params=params, **kw)
-                seeded = g is not None
-                break
+                lc = continue_fixed_point(system, prev[0], prev[1], params, **kw)
+                branch = prev[2]
             except AmbleError as e:
-                reason = f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
+                broke = _first_line(e)
         if lc is None:
-            row.update(status="failed", reason=reason, seeded=seeded)
+            try:
+                lc = find_fixed_point(system, None, params=params, **kw)
+                branch = flat[n] if flat is not None else i
+            except AmbleError as e:
+                reason = broke or _first_line(e)
+        if lc is None:
+            row.update(status="failed", reason=reason, seeded=prev is not None, branch_break=broke)
         else:
             mods = np.abs(lc.multipliers)
             row.update(status="ok", reason="", step_time=lc.step_time, max_modulus=float(mods.max()),
                        moduli=json.dumps([float(m) for m in mods]),
                        multipliers=json.dumps([[float(m.real), float(m.imag)] for m in lc.multipliers]),
-                       stable=lc.stable, residual=lc.residual, seeded=seeded)
+                       stable=lc.stable, residual=lc.residual, seeded=not broke and prev is not None,
+                       branch=branch, branch_break=broke)
             row.update({c: float(v) for c, v in zip(state_columns(snames), lc.fixed_point)})
-            guess = lc.fixed_point
+            prev = (lc.fixed_point, params, branch)
         out.append(row)
     return out
+
+
+def _seed_row(store: ResultStore, keys: list[list[tuple]], grp: Sequence[int], first: int,
+              base: dict[str, float], pnames: list[str], snames: Sequence[str]
+              ) -> tuple[list[float], dict[str, float], int] | None:
+    """The last converged row stored before point ``first`` of its group, read back exactly: its
+    gait, its parameters and its branch (a row from before branch ids: its own index)."""
+    x = seed_before(store, keys, grp, first, snames)
+    if x is None:
+        return None
+    for g in reversed(list(grp[:grp.index(first)])):
+        r = store.rows.get(keys[g][0])
+        if r is not None and r["status"] == "ok":
+            b = r.get("branch", "")
+            return x, {**base, **{nm: float(r[nm]) for nm in pnames}}, int(b) if b not in ("", None) else g
+    return None
 
 
 def _fp_sweep(system: HybridSystem, pnames: list[str], grid: list[tuple[int, int, tuple]],
@@ -77,9 +108,9 @@ def _fp_sweep(system: HybridSystem, pnames: list[str], grid: list[tuple[int, int
     keys = [[point_key(i, j, *vals)] for i, j, vals in grid]
 
     def make_task(pts: list[int], grp: Sequence[int], store: ResultStore) -> tuple:
-        # warm start: seeded by the last converged point before this one in the chunk, as stored (exact)
-        seed = seed_before(store, keys, grp, pts[0], snames) if warm_start else None
-        return (system, dict(params or {}), pnames, [grid[g] for g in pts], seed, fp_kw)
+        # warm start: continued from the last converged point before this one in the chunk, as stored (exact)
+        seed = _seed_row(store, keys, grp, pts[0], dict(params or {}), pnames, snames) if warm_start else None
+        return (system, dict(params or {}), pnames, [grid[g] for g in pts], seed, fp_kw, list(pts))
 
     return run_sweep(kind=kind, columns=_fp_columns(pnames, snames), key=["i", "j", *pnames], keys=keys,
                      groups=groups, make_task=make_task, fn=_fp_task, split=None if warm_start else 1,
@@ -93,15 +124,20 @@ def fixed_point_kind(system: HybridSystem, over: Mapping[str, np.ndarray], param
     at every value of one parameter (a branch), or on the grid of two (a map).
 
     One parameter: each chunk of ``chunk`` (default 32) consecutive values is one Dask task; inside
-    it the fixed point at one value is the Newton guess at the next (``warm_start=False``: every
-    point from the model's guess). A point that does not converge is recorded ``failed`` with its
-    reason and the next point is seeded from the last converged one (then from the model's guess).
+    it the gait at one value is continued along its branch to the next (``warm_start=False``:
+    every point from the model's guess). A point the branch does not reach is searched from the
+    model's guess and, if found, starts a new branch; one with no gait is recorded ``failed`` with
+    the reason (the branch folds, the walker fell, the branch was lost), and the next point is
+    continued from the last converged one.
     Two parameters ``{a: …, b: …}``: one task per value of ``a`` (``i``), warm-started along ``b``
     (``j``); ``chunk`` does not apply. ``tol``: the residual ``|P(x) − x|∞`` of a fixed point.
     Rows: ``i`` (index of the first parameter's value), ``j`` (of the second; 0 for a branch), the
     parameter values, ``status``, ``reason``, fixed point ``x_<state>``, ``step_time`` (s),
     multipliers (JSON ``[[re, im], ...]``) and their moduli, ``max_modulus``, ``stable``,
-    ``residual``, ``seeded``. ``SweepResult.kind``: ``fixed-point`` or ``fixed-point-map``.
+    ``residual``, ``seeded`` (continued from the point before), ``branch`` (the grid index of the
+    point where its branch was first found) and ``branch_break`` (why the branch of the point
+    before did not reach this one; empty when it did). ``SweepResult.kind``: ``fixed-point`` or
+    ``fixed-point-map``.
     """
     fp_kw = {"rtol": run.rtol, "atol": run.atol, "tol": tol}
     names = list(over)

@@ -189,10 +189,12 @@ def _jacobian(P: ReturnMap, x: np.ndarray, E: np.ndarray, S: np.ndarray, method:
     return np.array(cols).T
 
 
-def default_guess(system: HybridSystem, params: Mapping[str, float] | None = None, steps: int = 30) -> np.ndarray:
-    """A fixed-point guess: walk ``steps`` steps from the system's guess (or default start) at
-    these parameters and take the last post-impact state; the guess itself if that walk fails."""
-    start = system.fixed_point_guess
+def default_guess(system: HybridSystem, params: Mapping[str, float] | None = None, steps: int = 30,
+                  start: Sequence[float] | None = None) -> np.ndarray:
+    """A fixed-point guess: walk ``steps`` steps from ``start`` (default: the system's guess, or
+    its default start) at these parameters and take the last post-impact state; the start
+    itself if that walk fails."""
+    start = system.fixed_point_guess if start is None else start
     if start is None and not system.default_start:
         raise ConvergenceError(f"system {system.name!r} has neither a fixed-point guess nor a default start")
     tr = simulate(system, start, params=params, steps=steps, samples=False)  # events only: bounded memory
@@ -227,73 +229,105 @@ def find_fixed_point(
     Without a ``guess`` the search starts from :func:`default_guess`. At parameters other than
     the defaults, when that search fails or finds an unstable cycle, the model's own gait (its
     guess, on the cycle at the default parameters) is also followed to the requested parameters
-    by continuation, and the cycle found that way is returned if it is stable: a walker whose
-    default gait is stable finds the stable branch connected to it, not whichever cycle lies
-    nearest a poor guess.
+    by continuation (:func:`amble.analysis.homotopy.follow`: tangent predictor from the exact
+    parameter derivatives, step control, branch jumps refused, a parameter that only rescales
+    time, such as a passive walker's gravity, jumped exactly), and the cycle found that way is
+    returned if it is stable: a walker whose default gait is stable finds the stable branch
+    connected to it, not whichever cycle lies nearest a poor guess. When nothing is found the
+    error says why in one line (the branch folds, the walker fell, the branch was lost) with the
+    last gait found on the way.
     """
     if jacobian not in ("exact", "fd"):
         raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
     P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
-    x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params)
+    at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
+    start = _scaled_start(system, P) if guess is None and not at_defaults else None
+    x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params, start=start)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
         direct = _newton(system, P, x, period, tol, max_iter, jacobian)
     except (SimulationError, ConvergenceError) as e:
-        if guess is not None or not params:
+        if guess is not None or not params or at_defaults:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
-        direct = None
-    at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
+        direct, direct_error = None, str(e).splitlines()[0] if str(e) else type(e).__name__
     if direct is not None and (direct.stable or guess is not None or at_defaults):
         return direct
-    found = [direct] if direct is not None else []
-    error = None
-    for geometric in (False, True):
+    try:
+        followed = _from_defaults(system, P, period=period, tol=tol, max_iter=max_iter, jacobian=jacobian)
+    except ConvergenceError as e:
+        if direct is not None:
+            return direct
+        # both searches say why they failed (e.g. the walk at these parameters ends at rest)
+        raise ConvergenceError(f"{e}; from a walk at these parameters: {direct_error}") from None
+    return followed if followed.stable or direct is None else direct
+
+
+def continue_fixed_point(system: HybridSystem, x: Sequence[float], from_params: Mapping[str, float],
+                         params: Mapping[str, float], *, period: int = 1, rtol: float = FIXED_POINT_TOL,
+                         atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL, max_iter: int = 40) -> LimitCycle:
+    """The gait ``x`` (a fixed point at ``from_params``) carried to ``params`` along its branch
+    (:func:`amble.analysis.homotopy.follow`: tangent predictor from the exact parameter
+    derivatives, step control, branch jumps refused). :class:`ConvergenceError` says in one line
+    why the branch ends (it folds, the walker falls, it is lost) with the last gait on it."""
+    from .homotopy import follow
+
+    P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
+    Q = ReturnMap(system, from_params, period=period, rtol=rtol, atol=atol, mode=P.mode)
+    try:
+        xe = follow(Q, np.asarray(x, float), Q.p.copy(), P.p.copy(), tol=tol)
+    except SimulationError as e:
+        raise ConvergenceError(f"lost the branch: {e}") from None
+    return _newton(system, P, xe, period, tol, max_iter)
+
+
+def _scaled_start(system: HybridSystem, P: ReturnMap) -> np.ndarray | None:
+    """The model's guess with its velocities rescaled to the requested value of a parameter that
+    only rescales time (a passive walker's gravity), when there is one; else ``None``."""
+    from .homotopy import time_scaling
+
+    if system.fixed_point_guess is None:
+        return None
+    p0 = np.asarray(P.k.meta["param_defaults"], float)
+    P0 = ReturnMap(system, None, period=P.period, rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode)
+    x = np.asarray(system.fixed_point_guess, float)
+    try:
+        _, T = P0(x)
+    except SimulationError:
+        return None
+    sc = time_scaling(P0, x, T, p0, P.p)
+    return None if sc is None else sc[1]
+
+
+def _from_defaults(system: HybridSystem, P: ReturnMap, **kw: Any) -> LimitCycle:
+    """The model's own guess lies on the cycle at its default parameters: follow that cycle to
+    the parameters of ``P`` (:func:`amble.analysis.homotopy.follow`), along the straight path and
+    then, if that fails, the geometric one; a parameter that only rescales time jumps first."""
+    from .homotopy import follow, time_scaling
+
+    if system.fixed_point_guess is None:
+        raise ConvergenceError(f"no fixed point: system {system.name!r} has no gait at its defaults to follow")
+    p0 = np.asarray(P.k.meta["param_defaults"], float)
+    p1 = P.p.copy()
+    Q = ReturnMap(system, None, period=P.period, rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode)
+    x = np.asarray(system.fixed_point_guess, float)
+    try:
+        _, T = Q(x)
+        sc = time_scaling(Q, x, T, p0, p1)
+    except SimulationError:
+        sc = None
+    if sc is not None:
+        p0 = p0.copy()
+        p0[sc[0]] = p1[sc[0]]
+        x = sc[1]
+    errors = []
+    # with one parameter moving, the geometric path is the straight one run at another pace
+    for geometric in (False, True) if int(np.sum(p0 != p1)) > 1 else (False,):
         try:
-            followed = _from_defaults(system, P, x0, geometric, period=period, rtol=rtol, atol=atol, tol=tol,
-                                      max_iter=max_iter, jacobian=jacobian)
-        except ConvergenceError as e:
-            error = error or e
-            continue
-        if followed.stable:
-            return followed
-        found.append(followed)
-    if found:
-        return found[0]
-    raise error
-
-
-def _from_defaults(system: HybridSystem, P: ReturnMap, x0: np.ndarray, geometric: bool, stages: int = 16,
-                   **kw: Any) -> LimitCycle:
-    """The model's own guess lies on the cycle at its default parameters: follow the cycle from
-    there to the parameters of ``P`` in stages of ``1/stages`` of the way; a stage that fails is
-    halved (down to 1/32 of one), the next after a success doubled back, since cycles can move
-    fast near the target; at most ``3 × stages`` searches in all. The parameters move linearly,
-    or, with ``geometric``, those positive at both ends geometrically (masses, lengths and
-    gravity keep their ratios changing evenly)."""
-    defaults = dict(zip(P.k.meta["params"], P.k.meta["param_defaults"]))
-    target = dict(zip(P.k.meta["params"], P.p.tolist()))
-
-    def at(s: float) -> dict[str, float]:
-        return {k: defaults[k] * (target[k] / defaults[k]) ** s if geometric and defaults[k] > 0 and target[k] > 0
-                else defaults[k] + s * (target[k] - defaults[k]) for k in target}
-
-    x = np.asarray(system.fixed_point_guess if system.fixed_point_guess is not None else x0, float)
-    done, step, lc = 0.0, 1.0 / stages, None
-    for searches in range(1, 3 * stages + 1):
-        s = min(1.0, done + step)
-        try:
-            lc = find_fixed_point(system, x, params=target if s == 1.0 else at(s), **kw)
-        except ConvergenceError as e:
-            if step < 1.0 / (32 * stages) or searches == 3 * stages:
-                raise ConvergenceError(f"no fixed point: continuation from the default parameters failed at "
-                                       f"{done:.0%} of the way ({e})") from None
-            step /= 2
-            continue
-        x, done, step = lc.fixed_point, s, min(2 * step, 1.0 / stages)
-        if done == 1.0:
-            return lc
-    raise ConvergenceError(f"no fixed point: continuation from the default parameters reached only {done:.0%} "
-                           f"of the way in {3 * stages} searches")
+            xe = follow(Q, x, p0, p1, tol=kw["tol"], geometric=geometric)
+            return _newton(system, P, xe, P.period, kw["tol"], kw["max_iter"], kw["jacobian"])
+        except (ConvergenceError, SimulationError) as e:
+            errors.append(str(e).splitlines()[0] if str(e) else type(e).__name__)
+    raise ConvergenceError(f"no fixed point: following the default gait: {errors[0]}")
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,

@@ -38,6 +38,13 @@ def _float(text: str, what: str) -> float:
     return v
 
 
+def check_tol(tol: float) -> float:
+    """``--tol``: a positive finite number (the fixed-point residual), else :class:`UsageError`."""
+    if not (tol > 0 and math.isfinite(tol)):
+        raise UsageError(f"--tol must be a positive number, got {tol}")
+    return float(tol)
+
+
 def parse_sets(items: Sequence[str] | None) -> dict[str, float]:
     """``NAME=VALUE`` pairs → dict (values must be finite numbers)."""
     out: dict[str, float] = {}

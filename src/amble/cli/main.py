@@ -17,10 +17,10 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
-from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, SWEEP_TOL
+from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, RESIDUAL_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
-from .args import UsageError, _float, _Parser, load_model, parse_sets, robot_options, writable_path
+from .args import UsageError, _float, _Parser, check_tol, load_model, parse_sets, robot_options, writable_path
 from .cache import add_parser as add_cache_parser
 from .gait import add_parser as add_gait_parser
 from .gaits import EXAMPLE as GAITS_EXAMPLE
@@ -163,7 +163,8 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True, **robot_options(args))
     params = parse_sets(args.set)
     guess = _start(s, args.guess, params) if args.guess else None
-    lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol)
+    lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol,
+                          tol=check_tol(args.tol))
     out = lc.to_json()
     if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
         from ..analysis.gait_check import check_gait
@@ -327,6 +328,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     model_args(lc, FIXED_POINT_TOL)
     lc.add_argument("--period", type=int, default=1,
                     help="k for a period-k gait (default 1); all k points and step times are reported")
+    lc.add_argument("--tol", type=float, default=RESIDUAL_TOL,
+                    help=f"fixed-point tolerance: the largest residual |P(x) - x| of the gait (default "
+                         f"{RESIDUAL_TOL:g}, so that the fixed point is within 1e-10 of the map's)")
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
@@ -347,6 +351,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                     help="--kind basin: a coordinate of the initial post-impact state, give exactly two "
                          "(e.g. --x stance=-0.4:0:100 --x stance_dot=0.5:1.6:100); the other coordinates "
                          "come from the fixed point, the dependent ones from the post-impact section")
+    sw.add_argument("--tol", type=float, default=None,
+                    help=f"--kind fixed-point or continuation: the fixed-point tolerance, the largest residual "
+                         f"|P(x) - x| of each gait (default {RESIDUAL_TOL:g})")
     sw.add_argument("--steps", type=int, default=None,
                     help=f"--kind basin: footfalls walked from each initial state at most (default {BASIN_STEPS})")
     sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")

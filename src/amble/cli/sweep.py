@@ -21,7 +21,16 @@ from ..analysis.defaults import BASIN_STEPS
 from ..analysis.doubling import period_doubling
 from ..analysis.sweep import sweep
 from ..simulation.engine import Options
-from .args import UsageError, check_grid_size, load_model, parse_range, parse_sets, robot_options, writable_path
+from .args import (
+    UsageError,
+    check_grid_size,
+    check_tol,
+    load_model,
+    parse_range,
+    parse_sets,
+    robot_options,
+    writable_path,
+)
 from .output import number, write_output
 
 
@@ -40,6 +49,9 @@ def sweep_cli(args: Any) -> dict[str, Any]:
             raise UsageError(f"--{nm} must be a positive number, got {v}")
         if v is not None:
             Options(**{nm: v})  # the tolerances' domain, checked once before any work
+    tol = getattr(args, "tol", None)
+    if tol is not None and args.kind not in ("fixed-point", "continuation"):
+        raise UsageError(f"--tol applies to --kind fixed-point and continuation, not {args.kind}")
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be at least 1, got {args.workers}")
     threads = getattr(args, "threads", None)
@@ -64,6 +76,8 @@ def sweep_cli(args: Any) -> dict[str, Any]:
                                   progress=not getattr(args, "json", False))
     # a tolerance not given is the kind's own default (amble.analysis.defaults), read by the API
     common.update({nm: getattr(args, nm) for nm in ("rtol", "atol") if getattr(args, nm, None) is not None})
+    if tol is not None:
+        common["tol"] = check_tol(tol)
     summary: dict[str, Any] = {"model": args.model, "kind": args.kind,
                                ("coordinates" if basin_kind else "parameters"): names,
                                "ranges": [list(r[1:]) for r in ranges], "set": sets, "file": str(out) if out else None}
