@@ -116,6 +116,15 @@ class _Map:
         return (self.jacobian(q + 1j * h * v) @ v).imag / h
 
 
+def _full_mass_matrix(m, d) -> np.ndarray:
+    out = np.zeros((m.nv, m.nv))
+    try:
+        mujoco.mj_fullM(m, d, out)  # MuJoCo 4
+    except TypeError:
+        mujoco.mj_fullM(m, out, d.qM)  # MuJoCo 3
+    return out
+
+
 def _compare(path: Path, states: int = 20, fixed_base: bool = False, seed: int = 5) -> dict[str, float]:
     model = Model.from_mjcf(path, fixed_base=fixed_base)
     k = build(HybridSystem(model.name, model))
@@ -136,8 +145,7 @@ def _compare(path: Path, states: int = 20, fixed_base: bool = False, seed: int =
         q, v = rng.uniform(-1.2, 1.2, n), rng.uniform(-2.0, 2.0, n)
         d.qpos[:], d.qvel[:] = mp.qpos_qvel(q, v)
         mujoco.mj_forward(m, d)
-        Mm = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, Mm)
+        Mm = _full_mass_matrix(m, d)
         J, Jdv = mp.jacobian(q).real, mp.jdot_v(q, v)
         x = np.concatenate([q, v])
         M, h, G = k.dynamics(0, 0.0, x, np.zeros(1))

@@ -39,7 +39,6 @@ Gravity is ``opt.gravity`` (any direction).
 
 from __future__ import annotations
 
-import math
 import re
 import warnings
 from collections.abc import Mapping
