@@ -107,7 +107,7 @@ def _check(path: Path, states: int, seed: int = 11, massless: bool = False) -> f
         worst = max(worst, rel(M, Mr), rel(h, hr))
         if not massless:
             qdd = k.rhs(0, 0.0, x, p)[len(names):]
-            r = Mr @ qdd + hr
+            r = Mr @ qdd + hr + G.T @ (pm.damping * vp)  # the file's joint damping, as Pinocchio reads it
             worst = max(worst, np.abs(r).max() / (np.abs(Mr @ qdd).max() + np.abs(hr).max()))
     return worst
 
