@@ -133,6 +133,8 @@ def _compare(path: Path, states: int = 20, fixed_base: bool = False, seed: int =
         for j in [j for j in spec.joints if j.type == mujoco.mjtJoint.mjJNT_FREE]:
             spec.delete(j)
     m = spec.compile()
+    # amble reads neither contacts, joint limits nor actuators: MuJoCo's accelerations without them
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_ACTUATION
     d = mujoco.MjData(m)
     names = [str(s) for s in model.q]
     mp = _Map(m, names)
