@@ -176,6 +176,26 @@ def test_a_welded_base_matches_mujoco_without_its_free_joint():
     assert max(worst.values()) <= REL, worst
 
 
+def _gymnasium_asset(name: str) -> Path:
+    """A robot of Gymnasium's MuJoCo environments (a test dependency; located without importing it)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("gymnasium")
+    if spec is None or spec.origin is None:
+        pytest.skip("gymnasium (pip install gymnasium) ships the third-party robots; not installed")
+    return Path(spec.origin).parent / "envs" / "mujoco" / "assets" / name
+
+
+@pytest.mark.parametrize("name", ["ant.xml", "walker2d_v5.xml"])
+def test_third_party_robots_match_mujoco(name):
+    """Gymnasium's Ant (a quadruped on a free joint, armature and damping on its eight hinges) and
+    Walker2d (planar: slides and hinges at the root), actuators and contacts left out on both sides."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # their actuators and contacts are not read
+        worst = _compare(_gymnasium_asset(name), states=20)
+    assert max(worst.values()) <= REL, worst
+
+
 def test_the_coordinates_and_limits_of_a_file():
     model = Model.from_mjcf(DATA / "mjcf_floater.xml")
     assert [str(s) for s in model.q] == ["root_x", "root_y", "root_z", "root_yaw", "root_pitch", "root_roll",
