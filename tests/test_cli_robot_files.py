@@ -150,3 +150,13 @@ def test_a_robot_file_starts_warm_without_sympy_and_each_base_is_its_own_entry(t
     assert "amble.backend.compiled" in warm and "sympy" not in warm
     floating = _modules_after(fixed[:2] + fixed[3:], env)  # another base joint: another system
     assert "sympy" in floating
+
+
+def test_an_edit_to_an_included_mjcf_file_is_an_edit_to_the_robot(tmp_path):
+    from amble.models import source_files
+
+    (tmp_path / "arm.xml").write_text('<mujoco><worldbody><body name="arm"><joint name="a"/>'
+                                      '<geom size="0.1"/></body></worldbody></mujoco>')
+    (tmp_path / "robot.xml").write_text('<mujoco model="r"><include file="arm.xml"/></mujoco>')
+    files = source_files(str(tmp_path / "robot.xml"))
+    assert files == [(tmp_path / "robot.xml").resolve(), (tmp_path / "arm.xml").resolve()]

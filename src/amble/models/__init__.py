@@ -108,8 +108,30 @@ def source_files(spec: str) -> list[Path]:
     if is_file_spec(spec):
         return [Path(_split_spec(spec)[0]).resolve()]
     if is_robot_file(spec):
+        if Path(spec).suffix.lower() in _MJCF:
+            return _mjcf_files(Path(spec).resolve())
         return [Path(spec).resolve()]
     return sorted(f for d in __path__ for f in Path(d).resolve().glob("*.py"))
+
+
+def _mjcf_files(path: Path, seen: list[Path] | None = None) -> list[Path]:
+    """An MJCF file and the files it ``<include>``s (paths relative to the including file),
+    recursively: an edit to any of them is an edit to the robot."""
+    import xml.etree.ElementTree as ET
+
+    seen = [] if seen is None else seen
+    if path in seen:
+        return seen
+    seen.append(path)
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError):
+        return seen  # the loader says what is wrong with it
+    for inc in root.iter("include"):
+        name = inc.get("file")
+        if name:
+            _mjcf_files((path.parent / name).resolve(), seen)
+    return seen
 
 
 def load_traced(spec: str) -> tuple[HybridSystem, list[Path]]:
