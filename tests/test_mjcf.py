@@ -196,6 +196,48 @@ def test_third_party_robots_match_mujoco(name):
     assert max(worst.values()) <= REL, worst
 
 
+_TIED = """<mujoco model="tied"><worldbody>
+  <body name="a" pos="0 0 1" euler="10 0 5"><joint name="j1" axis="0 1 0.2" damping="0.2" armature="0.01"/>
+    <inertial pos="0.01 0 -0.2" quat="0.9 0.1 0.3 0" mass="1" diaginertia="0.02 0.015 0.006"/>
+    <body name="b" pos="0.02 0 -0.4"><joint name="j2" axis="1 0 0.3" pos="0 0.01 0" damping="0.1"
+        stiffness="2" armature="0.03"/>
+      <inertial pos="0 0.02 -0.1" mass="0.6" diaginertia="0.01 0.008 0.003"/>
+      <body name="c" pos="0 0 -0.3"><joint name="j3" type="slide" axis="0 0.2 1"/>
+        <inertial pos="0 0 -0.05" mass="0.3" diaginertia="0.002 0.002 0.001"/></body></body></body>
+</worldbody><equality><joint joint1="{one}" joint2="{two}" polycoef="0.1 {c1} 0 0 0"/></equality></mujoco>"""
+
+
+@pytest.mark.parametrize("one, two, c1", [("j2", "j1", -0.7), ("j1", "j2", 1.6)])
+def test_a_linear_joint_coupling_is_a_mimic_joint_checked_against_mujoco_projected(tmp_path, one, two, c1):
+    """``θ₁ = 0.1 + c1 θ₂``: one coordinate fewer. MuJoCo holds the coupling by a constraint force,
+    so the truth is its unconstrained M and bias (springs, dampers, armature of both joints)
+    projected on the coupling, ``Gᵀ M G`` and ``Gᵀ (h − passive)`` with ``G = ∂θ/∂a``."""
+    path = tmp_path / "tied.xml"
+    path.write_text(_TIED.format(one=one, two=two, c1=c1))
+    model = Model.from_mjcf(path)
+    names = [str(s) for s in model.q]
+    k = build(HybridSystem(model.name, model))
+    m = mujoco.MjModel.from_xml_path(str(path))
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    d = mujoco.MjData(m)
+    follower = "j2"  # the one read later follows: j2 = 0.1 + c1 j1, or j2 = (j1 − 0.1) / c1
+    kk, cc = (c1, 0.1) if one == "j2" else (1 / c1, -0.1 / c1)
+    assert names == ["j1", "j3"]
+    G = np.array([[1.0, 0.0], [kk, 0.0], [0.0, 1.0]])
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        a, v = rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2)
+        d.qpos[:] = G @ a + np.array([0.0, cc, 0.0])
+        d.qvel[:] = G @ v
+        mujoco.mj_forward(m, d)
+        Mm = _full_mass_matrix(m, d)
+        M, h, Gam = k.dynamics(0, 0.0, np.concatenate([a, v]), np.zeros(1))
+        rel = lambda x, y: float(np.abs(x - y).max() / np.abs(y).max())
+        assert rel(M, G.T @ Mm @ G) <= REL
+        assert rel(h - Gam, G.T @ (d.qfrc_bias - d.qfrc_passive)) <= REL
+    assert follower not in names
+
+
 def test_the_coordinates_and_limits_of_a_file():
     model = Model.from_mjcf(DATA / "mjcf_floater.xml")
     assert [str(s) for s in model.q] == ["root_x", "root_y", "root_z", "root_yaw", "root_pitch", "root_roll",
@@ -221,7 +263,8 @@ def test_limits_are_read_relative_to_the_reference(tmp_path):
 @pytest.mark.parametrize("body, extra, what", [
     ('<body name="a"><joint name="j"/><geom size="0.1"/></body>'
      '<body name="b"><joint name="k"/><geom size="0.1"/></body>',
-     '<equality><joint name="tie" joint1="j" joint2="k"/></equality>', "equality constraint <joint> 'tie'"),
+     '<equality><joint name="tie" joint1="j" joint2="k" polycoef="0 1 0.5 0 0"/></equality>',
+     "equality constraint <joint> 'tie'"),
     ('<body name="a"><joint name="j"/><geom size="0.1"/>'
      '<body name="b" pos="0 0 -1"><joint name="k"/><geom size="0.1"/></body></body>',
      '<equality><connect name="loop" body1="b" body2="world" anchor="0 0 -1"/></equality>',

@@ -30,8 +30,11 @@ generalised force ``−d q̇`` on the joint's coordinate, ``stiffness`` ``k`` th
 ``a`` to the diagonal of ``M``, as in MuJoCo). ``frictionloss`` is ignored with a warning, and so
 are actuators, tendons without stiffness or damping, inactive equality constraints and fluid
 forces (``density``, ``viscosity``, ``wind``); contacts are not read (the model has no ground).
-Refused with a one-line :class:`~amble.errors.ModelError` naming the element: an active equality
-constraint (a closed loop or a coupling), a tendon with stiffness or damping, gravity
+A linear ``<equality><joint>`` between two hinges or slides, ``θ₁ = c0 + c1 θ₂``, is a mimic
+joint of the tree (:mod:`amble.modelling.tree`): the joint read later follows the other, with one
+coordinate fewer (MuJoCo holds the same relation by a stiff constraint force).
+Refused with a one-line :class:`~amble.errors.ModelError` naming the element: any other active
+equality constraint (a closed loop, a weld, a tendon or polynomial coupling), a tendon with stiffness or damping, gravity
 compensation, damping, armature or stiffness on a free or ball joint, a free joint below another
 body, flexible bodies, and a file that MuJoCo's compiler refuses (its message is given).
 Gravity is ``opt.gravity`` (any direction).
@@ -90,19 +93,25 @@ def _quat_matrix(q: np.ndarray) -> np.ndarray:
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def _check_whole(m: Any, label: str) -> None:
-    """Refuse what the tree cannot hold; warn about what it leaves out."""
+def _check_whole(m: Any, label: str) -> dict[int, tuple[int, float, float]]:
+    """Refuse what the tree cannot hold; warn about what it leaves out. Returns the joints tied
+    to another by a linear ``<equality><joint>`` (``{follower: (joint followed, c1, c0)}``)."""
     mujoco = _mujoco()
     eq_names = {0: "connect", 1: "weld", 2: "joint", 3: "tendon", 4: "flex", 5: "distance"}
-    inactive = []
+    inactive, ties = [], {}
     for i in range(m.neq):
         kind = eq_names.get(int(m.eq_type[i]), "equality")
         nm = _name(m, mujoco.mjtObj.mjOBJ_EQUALITY, i, f"#{i}")
         if not bool(m.eq_active0[i]):
             inactive.append(nm)
             continue
-        raise ModelError(f"MJCF {label}: equality constraint <{kind}> {nm!r} is active: closed loops and "
-                         "couplings are not read (constrained chains are not supported)")
+        tie = _joint_tie(m, i) if kind == "joint" else None
+        if tie is None:
+            raise ModelError(f"MJCF {label}: equality constraint <{kind}> {nm!r} is active: closed loops and "
+                             "couplings other than a linear one of two hinges or slides are not read")
+        if tie[0] in ties:
+            raise ModelError(f"MJCF {label}: equality constraint <joint> {nm!r}: joint 1 is tied twice")
+        ties[tie[0]] = tie[1:]
     if inactive:
         warnings.warn(f"MJCF {label}: inactive equality constraints ignored: {', '.join(inactive)}", stacklevel=3)
     if getattr(m, "nflex", 0):
@@ -122,6 +131,25 @@ def _check_whole(m: Any, label: str) -> None:
         left_out.append("joint frictionloss")
     if left_out:
         warnings.warn(f"MJCF {label}: ignored: {', '.join(left_out)}", stacklevel=3)
+    return ties
+
+
+def _joint_tie(m: Any, i: int) -> tuple[int, int, float, float] | None:
+    """``(follower, joint followed, k, c)`` of an equality ``θ₁ = c0 + c1 θ₂`` between two hinge or
+    slide joints (MuJoCo's ``polycoef`` with no quadratic or higher term; both angles from
+    ``qpos0``), with ``θ_follower = k θ_followed + c`` and the follower read after the joint it
+    follows: the tree's mimic joint, held exactly where MuJoCo holds it by a stiff constraint force."""
+    j1, j2 = int(m.eq_obj1id[i]), int(m.eq_obj2id[i])
+    coef = np.asarray(m.eq_data[i][:5], dtype=float)
+    one_axis = (_HINGE, _SLIDE)
+    if j2 < 0 or m.jnt_type[j1] not in one_axis or m.jnt_type[j2] not in one_axis or np.any(coef[2:] != 0):
+        return None
+    c0, c1 = float(coef[0]), float(coef[1])
+    if j2 < j1:  # joints are numbered from the world outwards: the one followed is declared first
+        return j1, j2, c1, c0
+    if c1 == 0.0:  # joint 1 held at c0 by a joint read after it: a locked joint, not a coupling
+        return None
+    return j2, j1, 1.0 / c1, -c0 / c1  # θ₂ = (θ₁ − c0) / c1
 
 
 def _inertial(m: Any, b: int) -> tuple[float, np.ndarray, np.ndarray]:
@@ -130,26 +158,27 @@ def _inertial(m: Any, b: int) -> tuple[float, np.ndarray, np.ndarray]:
     return float(m.body_mass[b]), np.array(m.body_ipos[b], dtype=float), Ri @ np.diag(m.body_inertia[b]) @ Ri.T
 
 
-def _passive(ctx: dict, model: Any, j: int, coord: Any, what: str) -> None:
-    """The joint's damping, stiffness and armature as a force, a potential and a kinetic term."""
-    m, label = ctx["m"], ctx["label"]
+def _passive(ctx: dict, model: Any, j: int, body: Any, what: str) -> None:
+    """The joint's damping, stiffness and armature as a force, a potential and a kinetic term, on
+    the joint's angle ``θ = k a + c`` (``k = 1``, ``c = 0`` but for a tied joint) of the model
+    coordinate ``a``: ``−d k² ȧ``, ``k_s (θ − θ_spring)²/2``, ``arm k² ȧ²/2``."""
+    m = ctx["m"]
     d = int(m.jnt_dofadr[j])
     damping, armature, stiffness = float(m.dof_damping[d]), float(m.dof_armature[d]), float(m.jnt_stiffness[j])
     qa = int(m.jnt_qposadr[j])
     if m.jnt_type[j] in (_FREE, _BALL):
         n = 6 if m.jnt_type[j] == _FREE else 3
         if np.any(m.dof_damping[d:d + n] != 0) or np.any(m.dof_armature[d:d + n] != 0) or stiffness != 0:
-            raise ModelError(f"MJCF {label}: {what} has damping, armature or stiffness, which are read on hinge "
-                             "and slide joints only")
+            raise ModelError(f"MJCF {ctx['label']}: {what} has damping, armature or stiffness, which are read on "
+                             "hinge and slide joints only")
         return
-    rate = model.dot(coord)
     if damping:  # applied once every coordinate is declared (a force has one entry per coordinate)
-        ctx["damping"].append((coord, -damping * rate))
+        ctx["damping"].append((body.index, -damping * body.multiplier * body.rate))
     if armature:
-        model.add_kinetic(armature * rate**2 / 2)
+        model.add_kinetic(armature * body.rate**2 / 2)
     if stiffness:
         rest = float(m.qpos_spring[qa]) - float(m.qpos0[qa])
-        model.add_potential(stiffness * (coord - rest) ** 2 / 2)
+        model.add_potential(stiffness * (body.coordinate - rest) ** 2 / 2)
 
 
 def _limits(m: Any, j: int) -> dict[str, float | None]:
@@ -170,7 +199,8 @@ def _body_joints(ctx: dict, b: int, bname: str, parent: str | None) -> list[tupl
         return [(Joint("fixed", xyz=tuple(pos), rotation=Ro), None, None)]
     out = []
     for k, j in enumerate(range(adr, adr + num)):
-        jname = _name(m, mujoco.mjtObj.mjOBJ_JOINT, j, f"{bname}_joint{k}" if num > 1 else bname)
+        jname = ctx["joint_names"].setdefault(
+            j, _name(m, mujoco.mjtObj.mjOBJ_JOINT, j, f"{bname}_joint{k}" if num > 1 else bname))
         kind = int(m.jnt_type[j])
         first = k == 0
         p = np.array(m.jnt_pos[j], dtype=float)
@@ -185,16 +215,28 @@ def _body_joints(ctx: dict, b: int, bname: str, parent: str | None) -> list[tupl
                 out.append((Joint("floating", xyz=tuple(pos), rotation=np.eye(3), post_rotation=Ro), jname, j))
             continue
         xyz, rot = (pos + Ro @ p, Ro) if first else (p, np.eye(3))
+        tie = {}
+        if j in ctx["ties"]:
+            ref, k1, c0 = ctx["ties"][j]
+            tie = dict(mimic=ctx["joint_names"][ref], multiplier=k1, offset=c0)
         if kind == _BALL:
             joint = Joint("spherical", xyz=tuple(xyz), rotation=rot, post_xyz=tuple(-p))
         elif kind == _SLIDE:
             joint = Joint("prismatic", axis=tuple(m.jnt_axis[j]), xyz=tuple(pos) if first else (0.0, 0.0, 0.0),
-                          rotation=rot, **_limits(m, j))
+                          rotation=rot, **_limits(m, j), **tie)
         else:
             joint = Joint("revolute", axis=tuple(m.jnt_axis[j]), xyz=tuple(xyz), rotation=rot,
-                          post_xyz=tuple(-p), **_limits(m, j))
+                          post_xyz=tuple(-p), **_limits(m, j), **tie)
         out.append((joint, jname, j))
     return out
+
+
+def _joint_names(m: Any) -> dict[int, str]:
+    """The joints' names (characters other than letters, digits and ``_`` as ``_``); unnamed joints
+    are named when their body is read."""
+    mujoco = _mujoco()
+    return {j: _name(m, mujoco.mjtObj.mjOBJ_JOINT, j, "") for j in range(m.njnt)
+            if mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)}
 
 
 def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool = False,
@@ -207,13 +249,14 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
     m = compile_file(path)
     mujoco = _mujoco()
     label = path.name
-    _check_whole(m, label)
+    ties = _check_whole(m, label)
     model = cls(name or _name(m, mujoco.mjtObj.mjOBJ_MODEL, 0, "") or path.stem, dims=3)
     g = np.array(m.opt.gravity, dtype=float)
     gn = float(np.linalg.norm(g))
     model.gravity(gn, direction=list(g / gn) if gn else None)
     tree = model.rigid_tree()
-    ctx = {"m": m, "label": label, "fixed_base": fixed_base, "free": [], "damping": []}
+    ctx = {"m": m, "label": label, "fixed_base": fixed_base, "free": [], "damping": [], "ties": ties,
+           "joint_names": _joint_names(m)}
     names: dict[int, str] = {0: None}
     for b in range(1, m.nbody):
         bname = _name(m, mujoco.mjtObj.mjOBJ_BODY, b, f"body{b}")
@@ -221,24 +264,27 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
         mass, com, inertia = _inertial(m, b)
         joints = _body_joints(ctx, b, bname, parent)
         for k, (joint, coord, j) in enumerate(joints):
-            last = k == len(joints) - 1
-            if last:
-                tree.body(bname, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia, coordinate=coord)
+            if k == len(joints) - 1:
+                body = tree.body(bname, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
+                                 coordinate=coord)
                 frame = bname
             else:  # a massless frame between two joints of one body
                 frame = f"{bname}.{coord}"
                 if joint.type == "spherical":
-                    tree.body(frame, parent=parent, joint=joint, coordinate=coord)
+                    body = tree.body(frame, parent=parent, joint=joint, coordinate=coord)
                 else:
-                    tree._add(frame, parent, joint, 0, (0, 0, 0), ((0, 0, 0),) * 3, coord, None, internal=True)
+                    body = tree._add(frame, parent, joint, 0, (0, 0, 0), ((0, 0, 0),) * 3, coord, None,
+                                     internal=True)
                     model.touch()
             if j is not None and coord is not None:
-                _add_passive(ctx, model, j, coord, joint)
+                _passive(ctx, model, j, body, f"joint {coord!r}")
             parent = frame
         names[b] = bname
     if ctx["damping"]:
-        force = {str(c): f for c, f in ctx["damping"]}
-        model.force([force.get(str(q), 0) for q in model.q])
+        force: dict[int, Any] = {}
+        for i, f in ctx["damping"]:
+            force[i] = force.get(i, 0) + f
+        model.force([force.get(i, 0) for i in range(len(model.q))])
     for pname, spec in (contact_points or {}).items():
         try:
             body, at = spec
@@ -246,12 +292,3 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
             raise ModelError(f"contact point {pname!r}: give (body, (x, y, z)), got {spec!r}") from None
         tree.point(pname, body, at)
     return model
-
-
-def _add_passive(ctx: dict, model: Any, j: int, coord: str, joint: Joint) -> None:
-    what = f"joint {coord!r}"
-    if joint.type in ("floating", "spherical"):
-        _passive(ctx, model, j, None, what)
-        return
-    _passive(ctx, model, j, next(s for s in model.q if str(s) == coord), what)
-
