@@ -4,7 +4,9 @@ The file is read with `yourdfpy <https://github.com/clemense/yourdfpy>`_ — mai
 Python on top of lxml, and it parses without loading meshes or building a scene graph (the
 alternatives: ``urdfpy`` has had no release since 2020 and pins old dependencies;
 ``urdf_parser_py`` is tied to ROS packaging). Only the parsed elements are used: links with their
-inertials, joints with their type, origin, axis and limits. Everything is then checked here, and
+inertials, joints with their type, origin, axis, limits and ``<dynamics damping>`` (the generalised
+force ``−d θ̇``; Coulomb ``friction`` and ``<transmission>`` elements are ignored with a warning,
+:func:`_joint_dynamics`). Everything is then checked here, and
 a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
 
 * a joint of a type other than revolute, continuous, prismatic or fixed (``floating`` and
