@@ -34,9 +34,10 @@ A linear ``<equality><joint>`` between two hinges or slides, ``θ₁ = c0 + c1 �
 joint of the tree (:mod:`amble.modelling.tree`): the joint read later follows the other, with one
 coordinate fewer (MuJoCo holds the same relation by a stiff constraint force).
 Refused with a one-line :class:`~amble.errors.ModelError` naming the element: any other active
-equality constraint (a closed loop, a weld, a tendon or polynomial coupling), a tendon with stiffness or damping, gravity
-compensation, damping, armature or stiffness on a free or ball joint, a free joint below another
-body, flexible bodies, and a file that MuJoCo's compiler refuses (its message is given).
+equality constraint (a closed loop, a weld, a tendon or polynomial coupling), a tendon with
+stiffness or damping, gravity compensation, damping, armature or stiffness on a free or ball
+joint, a free joint below another body, flexible bodies, and a file that MuJoCo's compiler
+refuses (its message is given).
 Gravity is ``opt.gravity`` (any direction).
 """
 
