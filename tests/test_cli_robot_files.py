@@ -21,6 +21,7 @@ from amble.models import load_robot
 
 ROOT = Path(__file__).resolve().parents[1]
 RABBIT = str(Path(__file__).resolve().parent / "data" / "rabbit.urdf")
+MJCF_FLOATER = str(Path(__file__).resolve().parent / "data" / "mjcf_floater.xml")
 G = 9.81
 
 
@@ -90,13 +91,46 @@ def test_the_equations_of_a_robot_file(capsys):
 @pytest.mark.parametrize("args, what", [
     (("simulate", "compass-gait", "--base", "torso"), "apply to a robot file"),
     (("simulate", RABBIT, "--base", "nope"), "base link 'nope' is not a link"),
-    (("simulate", "robot.xml"), "MJCF files are not read"),
+    (("simulate", "robot.sdf"), "SDF files are not read"),
+    (("simulate", MJCF_FLOATER, "--base", "arm"), "an MJCF file keeps its own tree"),
     (("simulate", "missing.urdf"), "does not exist"),
 ])
 def test_bad_robot_requests_are_one_line_and_exit_2(capsys, args, what):
     code, _, err = _run(capsys, *args)
     assert code == 2
     assert what in err and len(err.strip().splitlines()) == 1
+
+
+def test_an_mjcf_robot_at_rest_falls_as_one_body(capsys, tmp_path):
+    """The free torso of the file falls from where the file places it; its limbs stay put."""
+    out = tmp_path / "fall.csv"
+    code, text, _ = _run(capsys, "simulate", MJCF_FLOATER, "--time", "0.5", "--out", str(out), "--json")
+    assert code == 0 and json.loads(text)["status"] == "end_time"
+    cols = _rows(out)
+    t = cols["t"]
+    assert np.allclose(cols["root_z"], -0.5 * G * t**2, rtol=0, atol=1e-9)
+    for name, v in cols.items():
+        if name not in ("t", "root_z", "root_z_dot", "kinetic_energy", "potential_energy"):
+            assert np.max(np.abs(v)) < 1e-9, name
+
+
+def test_a_fixed_base_mjcf_chain_keeps_its_energy(capsys, tmp_path):
+    pendulum = tmp_path / "double.xml"
+    pendulum.write_text(
+        '<mujoco model="double"><worldbody><body name="upper" pos="0 0 1" euler="5 -10 20">'
+        '<joint name="a" axis="0.3 1 0" pos="0 0 0.02"/>'
+        '<inertial pos="0.02 0 -0.2" quat="0.9 0.2 0.1 0.3" mass="1" diaginertia="0.02 0.015 0.008"/>'
+        '<body name="lower" pos="0 0.03 -0.4"><joint name="b" axis="1 0 0.2"/>'
+        '<inertial pos="0 0.01 -0.15" mass="0.6" diaginertia="0.01 0.009 0.003"/></body></body>'
+        '</worldbody></mujoco>')
+    out = tmp_path / "swing.csv"
+    code, _, _ = _run(capsys, "simulate", str(pendulum), "--fixed-base", "--time", "1", "--start",
+                      "x0=0.8,-0.5,1.0,2.0", "--out", str(out))
+    assert code == 0
+    cols = _rows(out)
+    e = cols["kinetic_energy"] + cols["potential_energy"]
+    assert np.max(np.abs(e - e[0])) < 1e-7 * (1 + abs(e[0]))
+    assert np.max(np.abs(cols["b_dot"])) > 0.5  # it did swing
 
 
 def _modules_after(args, env):
@@ -116,3 +150,13 @@ def test_a_robot_file_starts_warm_without_sympy_and_each_base_is_its_own_entry(t
     assert "amble.backend.compiled" in warm and "sympy" not in warm
     floating = _modules_after(fixed[:2] + fixed[3:], env)  # another base joint: another system
     assert "sympy" in floating
+
+
+def test_an_edit_to_an_included_mjcf_file_is_an_edit_to_the_robot(tmp_path):
+    from amble.models import source_files
+
+    (tmp_path / "arm.xml").write_text('<mujoco><worldbody><body name="arm"><joint name="a"/>'
+                                      '<geom size="0.1"/></body></worldbody></mujoco>')
+    (tmp_path / "robot.xml").write_text('<mujoco model="r"><include file="arm.xml"/></mujoco>')
+    files = source_files(str(tmp_path / "robot.xml"))
+    assert files == [(tmp_path / "robot.xml").resolve(), (tmp_path / "arm.xml").resolve()]

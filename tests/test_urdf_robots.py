@@ -107,7 +107,7 @@ def _check(path: Path, states: int, seed: int = 11, massless: bool = False) -> f
         worst = max(worst, rel(M, Mr), rel(h, hr))
         if not massless:
             qdd = k.rhs(0, 0.0, x, p)[len(names):]
-            r = Mr @ qdd + hr
+            r = Mr @ qdd + hr + G.T @ (pm.damping * vp)  # the file's joint damping, as Pinocchio reads it
             worst = max(worst, np.abs(r).max() / (np.abs(Mr @ qdd).max() + np.abs(hr).max()))
     return worst
 
@@ -180,6 +180,12 @@ def _outcome(path: Path) -> str:
         return f"refused: {e}"
 
 
+def _rounding(text: str) -> str:
+    """``text`` with numbers below 1e-15 in size (eigenvalues of rounding, which differ in their
+    digits from one linear-algebra library to another) written as ``≈0``."""
+    return re.sub(r"-?\d+(?:\.\d+)?e-(?:1[6-9]|[2-9]\d|\d{3})", "≈0", text)
+
+
 def _shipped() -> list[str]:
     return sorted(str(p.relative_to(ROBOTS)) for p in ROBOTS.rglob("*.urdf"))
 
@@ -206,7 +212,7 @@ def test_a_shipped_urdf_loads_or_is_refused_as_the_guide_says(rel):
         assert got == want
     else:  # the guide quotes the message: names in `backticks` for 'quotes', <tags> escaped
         reason = html.unescape(want.removeprefix("refused: ").replace("`", "'"))
-        assert got.startswith("refused: ") and reason in got, got
+        assert got.startswith("refused: ") and _rounding(reason) in _rounding(got), got
 
 
 def test_human_loads_with_massless_links_by_consent():

@@ -129,7 +129,7 @@ def robot_options(args: Any) -> dict[str, Any]:
 
     base, fixed = getattr(args, "base", None), bool(getattr(args, "fixed_base", False))
     if (base is not None or fixed) and not is_robot_file(args.model):
-        raise UsageError(f"--base and --fixed-base apply to a robot file (.urdf), not to {_shown(args.model)}")
+        raise UsageError(f"--base and --fixed-base apply to a robot file (.urdf, .xml), not to {_shown(args.model)}")
     return {"base": base, "fixed_base": fixed}
 
 

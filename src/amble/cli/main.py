@@ -34,7 +34,7 @@ MAX_PERIOD = 1000
 
 MODEL_HELP = ("a library model (see 'amble models'), a model file path/to/file.py[:callable]: the callable, "
               "else the file's build(), else the one HybridSystem it defines, or a robot file path/to/robot.urdf "
-              "(floating base, or --fixed-base)")
+              "(floating base, or --fixed-base) or MuJoCo's path/to/robot.xml (as the file says, or --fixed-base)")
 
 # ---------------------------------------------------------------------- commands
 def _plain(doc: str | None) -> str:

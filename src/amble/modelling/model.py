@@ -185,6 +185,16 @@ class Model(Actuators):
                            allow_massless=allow_massless, gravity=gravity, base_joint=base_joint,
                            base_coordinate=base_coordinate, parameters=parameters, pivot=pivot)
 
+    @classmethod
+    def from_mjcf(cls, path: Any, name: str | None = None, fixed_base: bool = False,
+                  contact_points: Any = None) -> Model:
+        """The robot of a MuJoCo MJCF file, read by MuJoCo's own compiler: bodies, joints (hinge,
+        slide, ball, free), inertias, gravity, joint damping, stiffness and armature; free bodies
+        welded where the file places them with ``fixed_base`` — see :mod:`amble.modelling.mjcf`."""
+        from .mjcf import build_model
+
+        return build_model(cls, path, name=name, fixed_base=fixed_base, contact_points=contact_points)
+
     @declaration
     def inertia(self, angle: Any, moment: Any) -> None:
         """Rotational inertia of a planar body turning with ``angle``: adds ``I·(dangle/dt)²/2``."""

@@ -4,7 +4,9 @@ The file is read with `yourdfpy <https://github.com/clemense/yourdfpy>`_ — mai
 Python on top of lxml, and it parses without loading meshes or building a scene graph (the
 alternatives: ``urdfpy`` has had no release since 2020 and pins old dependencies;
 ``urdf_parser_py`` is tied to ROS packaging). Only the parsed elements are used: links with their
-inertials, joints with their type, origin, axis and limits. Everything is then checked here, and
+inertials, joints with their type, origin, axis, limits and ``<dynamics damping>`` (the generalised
+force ``−d θ̇``; Coulomb ``friction`` and ``<transmission>`` elements are ignored with a warning,
+:func:`_joint_dynamics`). Everything is then checked here, and
 a bad file raises :class:`~amble.errors.ModelError` naming the link or joint:
 
 * a joint of a type other than revolute, continuous, prismatic or fixed (``floating`` and
@@ -350,6 +352,53 @@ def _massless(mass: Any, inertia: Any) -> bool:
         isinstance(v, float) and v == 0.0 for row in inertia for v in row)
 
 
+def _joint_dynamics(model: Any, tree: Any, order: list[tuple], path: Path) -> None:
+    """Each moving joint's ``<dynamics damping="d">`` as the generalised force ``−d θ̇`` on its
+    angle (or travel) ``θ``: by virtual work ``−d k² ȧ`` on the coordinate ``a`` of a mimic joint
+    ``θ = k a + c``. Coulomb ``friction`` (a set-valued force at rest) and ``<transmission>``
+    elements are ignored with a warning."""
+    import warnings
+    import xml.etree.ElementTree as ET
+
+    force: dict[int, Any] = {}
+    rubbing = []
+    for lk, _, j, _ in order:
+        dyn = j.dynamics
+        if j.type == "fixed" or dyn is None or lk not in tree._by_name:
+            continue
+        b = tree[lk]
+        # the parser keeps the attributes as text
+        d = _number(dyn.damping, f"URDF joint {j.name!r}: damping")
+        f = _number(dyn.friction, f"URDF joint {j.name!r}: friction")
+        if d:
+            force[b.index] = force.get(b.index, 0) - d * b.multiplier * b.rate
+        if f:
+            rubbing.append(j.name)
+    if force:
+        model.force([force.get(i, 0) for i in range(len(model.q))])
+    ignored = []
+    if rubbing:
+        ignored.append(f"joint friction ({', '.join(rubbing[:4])}{', …' if len(rubbing) > 4 else ''})")
+    transmissions = len(ET.parse(path).getroot().findall("transmission"))
+    if transmissions:
+        ignored.append(f"{transmissions} <transmission> element(s)")
+    if ignored:
+        warnings.warn(f"URDF {path.name}: ignored: {'; '.join(ignored)}", stacklevel=4)
+
+
+def _number(text: Any, what: str) -> float:
+    """A non-negative finite number of the file (``None``: 0)."""
+    if text is None:
+        return 0.0
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} {text!r} is not a number") from None
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ModelError(f"{what} {v:g} must be finite and non-negative")
+    return v
+
+
 def build_model(cls: type, path: Any, base: str | None = None, contact_points: Mapping | None = None,
                 name: str | None = None, allow_massless: bool = False, gravity: float = 9.81,
                 base_joint: Joint | None = None, base_coordinate: str = "base",
@@ -418,6 +467,7 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             continue
         tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
+    _joint_dynamics(model, tree, order, path)
     for pname, spec in (contact_points or {}).items():
         try:
             lk, at = spec

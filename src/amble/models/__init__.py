@@ -108,8 +108,30 @@ def source_files(spec: str) -> list[Path]:
     if is_file_spec(spec):
         return [Path(_split_spec(spec)[0]).resolve()]
     if is_robot_file(spec):
+        if Path(spec).suffix.lower() in _MJCF:
+            return _mjcf_files(Path(spec).resolve())
         return [Path(spec).resolve()]
     return sorted(f for d in __path__ for f in Path(d).resolve().glob("*.py"))
+
+
+def _mjcf_files(path: Path, seen: list[Path] | None = None) -> list[Path]:
+    """An MJCF file and the files it ``<include>``s (paths relative to the including file),
+    recursively: an edit to any of them is an edit to the robot."""
+    import xml.etree.ElementTree as ET
+
+    seen = [] if seen is None else seen
+    if path in seen:
+        return seen
+    seen.append(path)
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError):
+        return seen  # the loader says what is wrong with it
+    for inc in root.iter("include"):
+        name = inc.get("file")
+        if name:
+            _mjcf_files((path.parent / name).resolve(), seen)
+    return seen
 
 
 def load_traced(spec: str) -> tuple[HybridSystem, list[Path]]:
@@ -168,39 +190,57 @@ def _outside(path: str) -> Path | None:
     return p
 
 
-#: suffixes of robot description files the command line takes as a model
-ROBOT_SUFFIXES = (".urdf",)
+#: suffixes of robot description files the command line takes as a model (URDF, MuJoCo's MJCF)
+ROBOT_SUFFIXES = (".urdf", ".xml", ".mjcf")
+_MJCF = (".xml", ".mjcf")
 #: suffixes of robot descriptions that are recognised but not read
-_UNREAD = {".xml": "MJCF", ".mjcf": "MJCF", ".sdf": "SDF"}
+_UNREAD = {".sdf": "SDF"}
 
 
 def is_robot_file(spec: str) -> bool:
-    """Whether ``spec`` names a robot description file (``….urdf``; MJCF and SDF are recognised
-    and refused by :func:`load_robot`)."""
+    """Whether ``spec`` names a robot description file (``….urdf``, MJCF ``….xml``/``….mjcf``;
+    SDF is recognised and refused by :func:`load_robot`)."""
     return spec.lower().endswith(ROBOT_SUFFIXES + tuple(_UNREAD))
 
 
 def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: bool = False) -> HybridSystem:
-    """The robot of a URDF file as a system of one mode: its tree with ``base`` (default: the
-    file's root link) attached to the world by a ``floating`` joint (six coordinates
-    ``base_x``, ``base_y``, ``base_z`` (m) and ``base_yaw``, ``base_pitch``, ``base_roll`` (rad),
-    zero: the base link at the world origin, upright), or fixed to it with ``fixed_base``. No
-    ground, no contact: a floating robot falls, a fixed one swings under gravity. The default start
-    is every coordinate and rate zero; links without an inertial are massless."""
+    """The robot of a URDF or MJCF file as a system of one mode. No ground, no contact: a
+    floating robot falls, a fixed one swings under gravity; the default start is every coordinate
+    and rate zero.
+
+    A URDF: its tree with ``base`` (default: the file's root link) attached to the world by a
+    ``floating`` joint (six coordinates ``base_x``, ``base_y``, ``base_z`` (m) and ``base_yaw``,
+    ``base_pitch``, ``base_roll`` (rad), zero: the base link at the world origin, upright), or
+    fixed to it with ``fixed_base``; links without an inertial are massless.
+
+    An MJCF file (``.xml``, ``.mjcf``, read by MuJoCo's compiler): its bodies hang from the world
+    as the file writes them, a body with a free joint floats (coordinates named after the joint),
+    or is welded where the file places it with ``fixed_base``; zero is the file's pose. ``base``
+    is refused: the file's own tree is kept."""
     from ..modelling.hybrid import HybridSystem
     from ..modelling.model import Model
     from ..modelling.tree import Joint
 
     text = os.fspath(path)
-    kind = _UNREAD.get(Path(text).suffix.lower())
+    suffix = Path(text).suffix.lower()
+    kind = _UNREAD.get(suffix)
     if kind is not None:
-        raise ModelError(f"{text}: {kind} files are not read; give the robot as a URDF file")
+        raise ModelError(f"{text}: {kind} files are not read; give the robot as a URDF or MJCF file")
     if not Path(text).is_file():
         raise ModelError(f"robot file {text!r} does not exist")
-    model = Model.from_urdf(text, base=base, base_joint=None if fixed_base else Joint("floating"),
-                            allow_massless=True)
-    system = HybridSystem(model.name, model, doc=f"{Path(text).name}: "
-                          + ("fixed base" if fixed_base else "floating base") + f", {len(model.q)} coordinates")
+    if suffix in _MJCF:
+        if base is not None:
+            raise ModelError(f"--base {base}: an MJCF file keeps its own tree (its free joints float; "
+                             "--fixed-base welds them)")
+        model = Model.from_mjcf(text, fixed_base=fixed_base)
+        # a free joint is the tree's floating joint: its first frame hangs from the world
+        floats = any(b.parent is None and b.name.endswith(".x") for b in model.tree.bodies)
+        what = "floating base" if floats else "fixed base"
+    else:
+        model = Model.from_urdf(text, base=base, base_joint=None if fixed_base else Joint("floating"),
+                                allow_massless=True)
+        what = "fixed base" if fixed_base else "floating base"
+    system = HybridSystem(model.name, model, doc=f"{Path(text).name}: {what}, {len(model.q)} coordinates")
     system.default_start[model.name] = [0.0] * (2 * len(model.q))
     return system
 
