@@ -64,7 +64,7 @@ import math
 
 import sympy as sp
 
-from amble import POSITIVE, Explicit, Guard, HybridSystem, Model, R, interval
+from amble import POSITIVE, Explicit, Guard, HybridSystem, Model, interval
 
 NAME = "slip-runner"
 POSITION = 70  # place in `amble models` (ascending)
