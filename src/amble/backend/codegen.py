@@ -25,7 +25,7 @@ from ..derivation.switching import switching_surfaces
 from ..modelling.hybrid import HybridSystem, target_exprs
 from ..modelling.model import t
 from . import abi
-from .codegen_support import ModeInfo
+from .codegen_support import ModeInfo, count_ops
 from .codegen_support import Printer as _Printer
 from .codegen_support import block as _block
 from .codegen_support import bool_expr as _bool_block
@@ -52,7 +52,7 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     # common factors out of sums, m·l·(cos a cos b + sin a sin b) instead of m·(l cos a cos b + l sin a
     # sin b): the parameter part becomes one hoisted value (compass gait: −2 % instructions per walk);
     # small models only, where M and h are inlined into the right-hand side and factoring is cheap
-    if sum(sp.count_ops(e) for e in ex) <= INLINE_OPS:
+    if count_ops(ex) <= INLINE_OPS:
         ex = [sp.factor_terms(e) for e in ex]
     low = lambda i, j: ex[max(i, j) * (max(i, j) + 1) // 2 + min(i, j)]  # M[i, j] of the lower triangle
     nonzero = {(i, j) for i in range(n) for j in range(i) if low(i, j) != 0}
@@ -66,7 +66,7 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     # tree's M and h are names (its size is in the prelude): inlined into rhs_k, its q̈ is faster
     # (the humanoid's 10.8 µs against 14.3 µs out of line), so rhs_k keeps an inlined copy and
     # dynamics_k calls one in its own unit (both copies in one unit: 22 s of gcc instead of 11)
-    ops = sum(sp.count_ops(e) for e in ex)
+    ops = count_ops(ex)
     sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
     body = "    (void)t; (void)x; (void)p;\n" + _block(tg, ex, {**nm, **hoist.names}, prelude=prelude) + "}\n"
     inlined, own = f"static AMBLE_INLINE void mh_{k}{sig} {{\n" + body, f"AMBLE_HIDDEN void mh_{k}_out{sig} {{\n" + body

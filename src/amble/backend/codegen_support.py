@@ -12,7 +12,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import sympy as sp
+from sympy.concrete.summations import Sum
+from sympy.core.function import Derivative, _coeff_isneg
+from sympy.core.operations import LatticeOp
+from sympy.integrals.integrals import Integral
 from sympy.printing.c import C99CodePrinter
+from sympy.simplify.radsimp import fraction
 
 from ..derivation.equations import Equations
 from ..modelling.dag import fold
@@ -257,3 +262,70 @@ def shared_cse(exprs: list[sp.Expr]) -> tuple[list[tuple[sp.Symbol, sp.Expr]], l
 def bool_expr(expr: sp.Basic, names: dict[sp.Symbol, str]) -> str:
     """A sympy boolean as a C expression."""
     return Printer(names).doprint(expr)
+
+
+def _own_ops(a: sp.Basic) -> tuple[int, tuple]:
+    """The operations ``sympy.count_ops`` charges to ``a`` itself, and the expressions it goes on
+    to count (its arguments, or the numerator, denominator or negation it splits ``a`` into):
+    the body of ``count_ops``' work list, one item."""
+    if a.is_Rational:
+        return (0, ()) if a is sp.S.One else (int(a.p < 0) + int(a.q != 1), ())
+    w = 0
+    if a.is_Mul:
+        if _coeff_isneg(a):
+            w += 1
+            a = a.as_two_terms()[1] if a.args[0] is sp.S.NegativeOne else -a
+        num, den = fraction(a)
+        if num.is_Integer:
+            return w + 1 + int(bool(num < 0)), (den,)
+        if den is not sp.S.One:
+            return w + 1, ((num,) if den.is_Integer else (den, num))
+    elif a.is_Add:
+        negs = [_coeff_isneg(x) for x in a.args]
+        # one ADD or SUB between terms; -x - y is a NEG more (-x + y is a SUB instead of an ADD)
+        return len(a.args) - 1 + int(all(negs)), tuple(-x if ng else x for x, ng in zip(a.args, negs))
+    if a.is_Pow and a.exp is sp.S.NegativeOne:
+        return w + 1, (a.base,)
+    if a == sp.S.Exp1:
+        return w + 1, ()
+    if a.is_Pow and a.base == sp.S.Exp1:
+        return w + 1, (a.exp,)
+    if a.is_Mul or isinstance(a, LatticeOp):
+        w += len(a.args) - 1
+    elif a.args and (a.is_Pow or a.is_Function or isinstance(a, (Derivative, Integral, Sum))):
+        w += 1
+    return w, (() if a.is_Symbol else a.args)
+
+
+def count_ops(exprs: list[Any], memo: dict | None = None) -> int:
+    """``sum(sympy.count_ops(e) for e in exprs)``, the same number, with each distinct
+    subexpression counted once and its count reused at every further use (``memo``: expression →
+    operations as a tree). ``sympy.count_ops`` walks a shared subexpression again at every use:
+    on expressions that share their parts (a Lagrangian's derivatives, a chain's kinematics) that
+    is a walk of the tree they spell out, exponentially larger than the graph. Linear in the
+    number of distinct subexpressions."""
+    memo = {} if memo is None else memo
+    own: dict[sp.Basic, tuple[int, tuple]] = {}
+    total = 0
+    for e in exprs:
+        e = sp.sympify(e)
+        if not isinstance(e, sp.Expr) or e.is_Relational:
+            total += sp.count_ops(e)
+            continue
+        stack = [e]
+        while stack:  # post-order: an item's count once those of the items it goes on to are known
+            a = stack[-1]
+            if a in memo:
+                stack.pop()
+                continue
+            if a not in own:
+                own[a] = _own_ops(a)
+            w, kids = own[a]
+            todo = [k for k in kids if k not in memo]
+            if todo:
+                stack.extend(todo)
+                continue
+            memo[a] = w + sum(memo[k] for k in kids)
+            stack.pop()
+        total += memo[e]
+    return total
