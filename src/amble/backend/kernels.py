@@ -220,21 +220,13 @@ class Kernels:
         """The index of a mode given by name or index (:class:`~amble.errors.ModelError` if none)."""
         if type(mode) is int and 0 <= mode < self.n_modes:
             return mode
-        i = self._mode_ix.get(mode) if isinstance(mode, str) else _index(mode, self.n_modes)
-        if i is None:
-            raise ModelError(f"unknown mode {mode!r}; modes: {', '.join(self.meta['modes'])} "
-                             f"(or their indices 0 … {self.n_modes - 1})")
-        return i
+        return _lookup("mode", mode, self._mode_ix, self.n_modes)
 
     def transition_index(self, transition: str | int) -> int:
         """The index of a transition given by name or index (:class:`~amble.errors.ModelError` if none)."""
         if type(transition) is int and 0 <= transition < self.n_tr:
             return transition
-        i = self._tr_ix.get(transition) if isinstance(transition, str) else _index(transition, self.n_tr)
-        if i is None:
-            raise ModelError(f"unknown transition {transition!r}; transitions: {', '.join(self._tr_ix)} "
-                             f"(or their indices 0 … {self.n_tr - 1})")
-        return i
+        return _lookup("transition", transition, self._tr_ix, self.n_tr)
 
     def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
         """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
@@ -539,6 +531,16 @@ def _index(i: Any, n: int) -> int | None:
     except TypeError:
         return None
     return i if 0 <= i < n else None
+
+
+def _lookup(kind: str, key: Any, table: dict[str, int], n: int) -> int:
+    """The index of a mode or transition named by ``key`` (a name in ``table`` or an index below
+    ``n``); the slow path of ``Kernels.mode_index``/``transition_index``, whose plain-int test
+    stays inline because it runs on every per-state call."""
+    i = table.get(key) if isinstance(key, str) else _index(key, n)
+    if i is None:
+        raise ModelError(f"unknown {kind} {key!r}; {kind}s: {', '.join(table)} (or their indices 0 … {n - 1})")
+    return i
 
 
 def _arg(a: Any, n: int, error: type[Exception], what: str) -> tuple[int, np.ndarray]:
