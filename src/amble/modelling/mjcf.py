@@ -174,7 +174,7 @@ def _passive(ctx: dict, model: Any, j: int, body: Any, what: str) -> None:
                              "hinge and slide joints only")
         return
     if damping:  # applied once every coordinate is declared (a force has one entry per coordinate)
-        ctx["damping"].append((body.index, -damping * body.multiplier * body.rate))
+        ctx["damping"].append((body, damping))
     if armature:
         model.add_kinetic(armature * body.rate**2 / 2)
     if stiffness:
@@ -281,11 +281,7 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
                 _passive(ctx, model, j, body, f"joint {coord!r}")
             parent = frame
         names[b] = bname
-    if ctx["damping"]:
-        force: dict[int, Any] = {}
-        for i, f in ctx["damping"]:
-            force[i] = force.get(i, 0) + f
-        model.force([force.get(i, 0) for i in range(len(model.q))])
+    tree.joint_damping(ctx["damping"])
     for pname, spec in (contact_points or {}).items():
         try:
             body, at = spec

@@ -313,6 +313,18 @@ class RigidTree:
     def __getitem__(self, name: str) -> Body:
         return self._by_name[name]
 
+    def joint_damping(self, dampings: Sequence[tuple[Body, Any]]) -> None:
+        """Viscous damping ``d`` (N·m·s/rad or N·s/m) of each body's joint as the generalised force
+        ``−d θ̇`` on its angle (or travel) ``θ``; by virtual work ``−d k² ȧ`` on the coordinate
+        ``a`` of a mimic joint ``θ = k a + c``. Dampings of joints that share a coordinate add up.
+        One force of the model (a force has one entry per coordinate), so call it once every
+        coordinate is declared."""
+        force: dict[int, Any] = {}
+        for b, d in dampings:
+            force[b.index] = force.get(b.index, 0) - d * b.multiplier * b.rate
+        if force:
+            self.model.force([force.get(i, 0) for i in range(len(self.model.q))])
+
     @property
     def moving_bodies(self) -> list[Body]:
         return [b for b in self.bodies if b.moving]

@@ -100,20 +100,21 @@ class _Params:
                      for a, v in zip("xyz", xyz))
 
 
-def _read(path: Path) -> Any:
+def _read(path: Path) -> tuple[Any, Any]:
+    """The parsed URDF and the root element of the strict parse (:func:`_check_document`)."""
     try:
         import yourdfpy
     except ImportError as e:  # pragma: no cover - a declared dependency
         raise ModelError("URDF import needs the 'yourdfpy' package: pip install 'amble[urdf]'") from e
-    _check_document(path)
+    root = _check_document(path)
     try:
         return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
-                                  build_collision_scene_graph=False, load_collision_meshes=False)
+                                  build_collision_scene_graph=False, load_collision_meshes=False), root
     except Exception as e:  # the parser's own errors (malformed XML, missing attributes)
         raise ModelError(f"URDF {path.name}: cannot be read: {e}") from e
 
 
-def _check_document(path: Path) -> None:
+def _check_document(path: Path) -> Any:
     """:class:`ModelError` for a file that is not well-formed XML (a truncated file, a NUL byte),
     is not a robot (another root element, no link, no name) or whose elements contradict each
     other: two links or two joints of one name, a ``<mimic>`` naming no joint of the file.
@@ -121,7 +122,7 @@ def _check_document(path: Path) -> None:
     The parser falls back to a recovering parse when the strict one fails, which reads a file
     cut short or holding a NUL byte as if the missing or unreadable elements had never been
     there (a robot with fewer links and no complaint); it also keeps one of two links of the same
-    name. So the file is parsed strictly here first."""
+    name. So the file is parsed strictly here first; its root element is returned."""
     import xml.etree.ElementTree as ET
 
     try:
@@ -158,6 +159,7 @@ def _check_document(path: Path) -> None:
             if target not in joints:
                 raise ModelError(f"URDF joint {el.get('name')!r}: <mimic> names joint {target!r}, "
                                  "which the file does not declare")
+    return root
 
 
 #: relative tolerance of the inertia checks: the rounding of numbers written to a file
@@ -352,15 +354,14 @@ def _massless(mass: Any, inertia: Any) -> bool:
         isinstance(v, float) and v == 0.0 for row in inertia for v in row)
 
 
-def _joint_dynamics(model: Any, tree: Any, order: list[tuple], path: Path) -> None:
+def _joint_dynamics(tree: Any, order: list[tuple], path: Path, transmissions: int) -> None:
     """Each moving joint's ``<dynamics damping="d">`` as the generalised force ``−d θ̇`` on its
     angle (or travel) ``θ``: by virtual work ``−d k² ȧ`` on the coordinate ``a`` of a mimic joint
     ``θ = k a + c``. Coulomb ``friction`` (a set-valued force at rest) and ``<transmission>``
     elements are ignored with a warning."""
     import warnings
-    import xml.etree.ElementTree as ET
 
-    force: dict[int, Any] = {}
+    damped = []
     rubbing = []
     for lk, _, j, _ in order:
         dyn = j.dynamics
@@ -371,15 +372,13 @@ def _joint_dynamics(model: Any, tree: Any, order: list[tuple], path: Path) -> No
         d = _number(dyn.damping, f"URDF joint {j.name!r}: damping")
         f = _number(dyn.friction, f"URDF joint {j.name!r}: friction")
         if d:
-            force[b.index] = force.get(b.index, 0) - d * b.multiplier * b.rate
+            damped.append((b, d))
         if f:
             rubbing.append(j.name)
-    if force:
-        model.force([force.get(i, 0) for i in range(len(model.q))])
+    tree.joint_damping(damped)
     ignored = []
     if rubbing:
         ignored.append(f"joint friction ({', '.join(rubbing[:4])}{', …' if len(rubbing) > 4 else ''})")
-    transmissions = len(ET.parse(path).getroot().findall("transmission"))
     if transmissions:
         ignored.append(f"{transmissions} <transmission> element(s)")
     if ignored:
@@ -417,7 +416,8 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         if base_joint.post_xyz is not None:
             raise ModelError(f"pivot {pivot!r}: the base joint has an offset after its motion already")
         base_joint = dataclasses.replace(base_joint, post_xyz=tuple(-float(v) for v in spec[1]))
-    robot = _read(path).robot
+    urdf, root = _read(path)
+    robot = urdf.robot
     links, base, order = _tree_order(robot, base, path)
     mimics = _mimics(robot)
     order = _mimic_order(order, mimics)
@@ -467,7 +467,7 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
             continue
         tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
-    _joint_dynamics(model, tree, order, path)
+    _joint_dynamics(tree, order, path, len(root.findall("transmission")))
     for pname, spec in (contact_points or {}).items():
         try:
             lk, at = spec
