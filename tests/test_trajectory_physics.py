@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from amble.cli.main import main
-from tests.oracles import rabbit_zero_dynamics as rabbit_oracle
+from oracles import rabbit_zero_dynamics as rabbit_oracle
 
 
 def _read(path):

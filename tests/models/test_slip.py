@@ -4,7 +4,7 @@ import math
 
 import amble
 from amble.models.slip import build
-from tests.oracles.slip import Slip
+from oracles.slip import Slip
 
 M, G, K, L0 = 80.0, 9.81, 20000.0, 1.0
 
