@@ -11,9 +11,9 @@ import math
 
 import numpy as np
 import pytest
+from oracles import rabbit_zero_dynamics as rabbit_oracle
 
 from amble.cli.main import main
-from oracles import rabbit_zero_dynamics as rabbit_oracle
 
 
 def _read(path):

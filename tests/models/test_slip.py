@@ -2,9 +2,10 @@
 
 import math
 
+from oracles.slip import Slip
+
 import amble
 from amble.models.slip import build
-from oracles.slip import Slip
 
 M, G, K, L0 = 80.0, 9.81, 20000.0, 1.0
 

@@ -22,6 +22,8 @@ from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
 from .args import UsageError, _float, _Parser, check_tol, load_model, parse_sets, robot_options, writable_path
 from .cache import add_parser as add_cache_parser
+from .doublings import EXAMPLE as DOUBLINGS_EXAMPLE
+from .doublings import add_parser as add_doublings_parser
 from .gait import add_parser as add_gait_parser
 from .gaits import EXAMPLE as GAITS_EXAMPLE
 from .gaits import add_parser as add_gaits_parser
@@ -233,6 +235,7 @@ EXAMPLES = {
     "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
     "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
     "gaits": GAITS_EXAMPLE,
+    "doublings": DOUBLINGS_EXAMPLE,
     "mfpt": MFPT_EXAMPLE,
     "cache": "amble cache clear --older-than 30 --dry-run",
 }
@@ -375,6 +378,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
     add_gait_parser(add, model_arg)
     add_gaits_parser(add, model_arg)
+    add_doublings_parser(add, model_arg)
     add_mfpt_parser(add, model_arg)
     add_cache_parser(add)
     return p

@@ -128,7 +128,7 @@ def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tup
         raise usage("--x and --steps apply to --kind basin only")
     if not params:
         raise usage(f"--kind {args.kind} needs --param NAME=START:STOP:COUNT (once, or twice for a 2D map)")
-    ranges = [_continuation_range(t, usage) if args.kind == "continuation" else parse_range(t) for t in params]
+    ranges = [continuation_range(t, usage) if args.kind == "continuation" else parse_range(t) for t in params]
     if len(ranges) not in (1, 2):
         raise usage(f"--param: give one (branch) or two (map) parameters, got {len(ranges)}")
     if args.kind in ("bifurcation", "continuation") and len(ranges) != 1:
@@ -139,7 +139,7 @@ def _check_grid(args: Any, basin_kind: bool, usage: type[Exception]) -> list[tup
     return ranges
 
 
-def _continuation_range(text: str, usage: type[Exception]) -> tuple[str, float, float, int]:
+def continuation_range(text: str, usage: type[Exception]) -> tuple[str, float, float, int]:
     """``NAME=START:STOP[:STEPS]`` of ``--kind continuation``: STOP may lie below START (the branch
     is followed downwards); STEPS (default 50) bounds the parameter change per step by
     |STOP − START| / STEPS."""
