@@ -14,11 +14,13 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import shutil
 import subprocess
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -63,27 +65,67 @@ def check_writer(path: str | Path) -> None:
 
 def write_movie(traj: Trajectory, path: Path, fps: float, shapes: Sequence[Any], slope: float | None,
                 progress: bool | None = None) -> Path:
-    from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
     from tqdm.auto import tqdm
-
-    from .scene import Cylinder, Sphere
 
     check_writer(path)
     fps = movie_fps(path, fps)
+    mf = movie_figure(traj, fps, shapes, slope)
+    frames = _frames(mf)
+    part = path.with_name(f".{path.stem}.part{path.suffix}")
+    bar = tqdm(total=len(mf.times), desc=f"writing {path.name}", unit="frame",
+               disable=None if progress is None else not progress, leave=False)
+
+    def counted():
+        for frame in frames:
+            bar.update(1)
+            yield frame
+
+    try:
+        if path.suffix.lower() == ".gif":
+            _write_gif(counted(), part, fps)
+        else:
+            _write_mp4(counted(), part, fps)
+        os.replace(part, path)
+    except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
+        raise ExportError(f"cannot write {path.name}: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
+                          ) from None
+    finally:
+        bar.close()
+        if part.exists():
+            part.unlink()
+    return path
+
+
+@dataclass
+class MovieFigure:
+    """The figure of a movie: ``update(f)`` poses the moving ``artists`` at sample ``f`` of ``times``."""
+
+    figure: Any
+    canvas: Any
+    times: np.ndarray
+    artists: list[Any]
+    update: Callable[[int], None]
+
+
+def movie_figure(traj: Trajectory, fps: float, shapes: Sequence[Any], slope: float | None) -> MovieFigure:
+    """A side view (and a front view for a 3D model) of the links and balls of ``shapes``, with
+    a walker's ground and a clock, sampled at ``fps``; the moving artists are marked animated."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .scene import Cylinder, Sphere
+
     system = traj.system
     times, pts = traj.resample(fps)
     links = [s for s in shapes if isinstance(s, Cylinder)]
     balls = [s for s in shapes if isinstance(s, Sphere)]
     views = [(0, 2, "side (x–z)")] + ([(1, 2, "front (y–z)")] if system.dims == 3 else [])
     fig = Figure(figsize=(5 * len(views), 4))
-    FigureCanvasAgg(fig)
+    canvas = FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(views), squeeze=False)
     allp = np.concatenate([np.nan_to_num(v) for v in pts.values()])
-    artists = []
-    unit = system.time_unit
-    clock = fig.text(0.01, 0.97, "", ha="left", va="top", family="monospace")
+    clock = fig.text(0.01, 0.97, "", ha="left", va="top", family="monospace", animated=True)
+    moving: list[tuple[int, int, list[Any], list[Any]]] = []
     for ax, (i, j, title) in zip(axes[0], views):
         ax.set_aspect("equal")
         ax.set_title(title)
@@ -95,42 +137,95 @@ def write_movie(traj: Trajectory, path: Path, fps: float, shapes: Sequence[Any],
             ax.plot(xs, -np.tan(slope) * xs, color="0.5")
         else:
             ax.set_ylim(lo[j], hi[j])
-        lines = [ax.plot([], [], "-", color="0.4", lw=2)[0] for _ in links]
-        dots = [ax.plot([], [], "o", color=s.color, ms=4 + 60 * s.radius)[0] for s in balls]
-        artists.append((i, j, lines, dots))
+        lines = [ax.plot([], [], "-", color="0.4", lw=2, animated=True)[0] for _ in links]
+        dots = [ax.plot([], [], "o", color=s.color, ms=4 + 60 * s.radius, animated=True)[0] for s in balls]
+        moving.append((i, j, lines, dots))
+    unit = system.time_unit
 
-    def draw(f: int):
-        out = [clock]
+    def update(f: int) -> None:
         clock.set_text(f"t = {times[f]:.2f} {unit}")
-        for i, j, lines, dots in artists:
+        for i, j, lines, dots in moving:
             for ln, s in zip(lines, links):
                 a, b = pts[s.between[0]][f], pts[s.between[1]][f]
                 ln.set_data([a[i], b[i]], [a[j], b[j]])
-                out.append(ln)
             for d, s in zip(dots, balls):
                 d.set_data([pts[s.at][f][i]], [pts[s.at][f][j]])
-                out.append(d)
-        return out
 
-    anim = FuncAnimation(fig, draw, frames=len(times), interval=1000 / fps, blit=False)
-    if path.suffix.lower() == ".gif":
-        writer: Any = PillowWriter(fps=fps)
-    else:
-        import matplotlib
+    artists = [clock] + [a for _, _, lines, dots in moving for a in (*lines, *dots)]
+    return MovieFigure(fig, canvas, times, artists, update)
 
-        matplotlib.rcParams["animation.ffmpeg_path"] = ffmpeg_path()
-        writer = FFMpegWriter(fps=fps)
-    part = path.with_name(f".{path.stem}.part{path.suffix}")
-    bar = tqdm(total=len(times), desc=f"writing {path.name}", unit="frame",
-               disable=None if progress is None else not progress, leave=False)
+
+def _frames(mf: MovieFigure) -> Iterator[np.ndarray]:
+    """The movie's frames (RGB, uint8, height × width × 3).
+
+    The still parts of the figure (axes, ticks, ground) are drawn once; each frame restores that
+    background and draws only the moving artists (Agg blitting). Redrawing the whole figure, as
+    ``FuncAnimation.save`` does (twice per frame), spends ~95 % of a movie's time on tick labels."""
+    mf.canvas.draw()  # the still figure: animated artists are left out of it
+    background = mf.canvas.copy_from_bbox(mf.figure.bbox)
+    for f in range(len(mf.times)):
+        mf.canvas.restore_region(background)
+        mf.update(f)
+        for a in mf.artists:
+            (a.axes or mf.figure).draw_artist(a)
+        yield np.asarray(mf.canvas.buffer_rgba())[:, :, :3].copy()
+
+
+def _write_gif(frames: Iterator[np.ndarray], path: Path, fps: float) -> None:
+    """Frames to a looping GIF with one palette for all: the first frame's 256 most frequent colours
+    (the scene's colours do not change; the background stays exactly white). Each pixel takes its
+    colour's palette index, found once per new colour (the nearest palette colour) and then looked
+    up — Pillow's ``quantize(palette=…)`` matches on a coarser colour cube and tints the white."""
+    from PIL import Image
+
+    first = next(frames)
+    colours, counts = np.unique(_packed(first), return_counts=True)
+    palette = colours[np.argsort(-counts, kind="stable")[:256]]
+    rgb = np.stack([(palette >> 16) & 255, (palette >> 8) & 255, palette & 255], axis=1)
+    # a table over all 2^24 colours (16 MB each): a gather per frame instead of a search
+    seen = np.zeros(1 << 24, bool)
+    lut = np.zeros(1 << 24, np.uint8)
+    seen[palette], lut[palette] = True, np.arange(len(palette), dtype=np.uint8)
+    flat = np.zeros((256, 3), np.uint8)
+    flat[: len(rgb)] = rgb
+    images = []
+    for f in itertools.chain([first], frames):
+        p = _packed(f)
+        new = np.unique(p[~seen[p]])
+        if new.size:  # colours not met before: their nearest palette colour, remembered
+            c = np.stack([(new >> 16) & 255, (new >> 8) & 255, new & 255], axis=1).astype(np.int32)
+            near = np.argmin(((c[:, None, :] - rgb[None, :, :].astype(np.int32)) ** 2).sum(axis=2), axis=1)
+            seen[new], lut[new] = True, near.astype(np.uint8)
+        im = Image.fromarray(lut[p], mode="P")
+        im.putpalette(flat.ravel().tolist())
+        images.append(im)
+    images[0].save(path, format="GIF", save_all=True, append_images=images[1:], duration=round(1000 / fps), loop=0,
+                   optimize=False)
+
+
+def _packed(frame: np.ndarray) -> np.ndarray:
+    """An RGB frame's pixels as one int32 each (0xRRGGBB), height × width."""
+    f = frame.astype(np.int32)
+    return (f[:, :, 0] << 16) | (f[:, :, 1] << 8) | f[:, :, 2]
+
+
+def _write_mp4(frames: Iterator[np.ndarray], path: Path, fps: float) -> None:
+    """Frames piped to ffmpeg as raw RGB (H.264, yuv420p so that every player shows it)."""
+    first = next(frames)
+    h, w = first.shape[:2]
+    cmd = [ffmpeg_path() or "ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+           "-s", f"{w}x{h}", "-r", f"{fps:g}", "-i", "-", "-vcodec", "libx264", "-pix_fmt", "yuv420p",
+           # yuv420p needs even sides
+           "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-f", "mp4", str(path)]
+    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
-        anim.save(part, writer=writer, progress_callback=lambda i, n: bar.update(1))
-        os.replace(part, path)
-    except (ValueError, RuntimeError, OSError, subprocess.SubprocessError) as e:
-        raise ExportError(f"cannot write {path.name}: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
-                          ) from None
-    finally:
-        bar.close()
-        if part.exists():
-            part.unlink()
-    return path
+        assert proc.stdin is not None
+        proc.stdin.write(first.tobytes())
+        for f in frames:
+            proc.stdin.write(f.tobytes())
+        proc.stdin.close()
+    except BrokenPipeError:
+        pass
+    err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+    if proc.wait() != 0:
+        raise RuntimeError(f"ffmpeg failed: {err.strip().splitlines()[-1] if err.strip() else proc.returncode}")

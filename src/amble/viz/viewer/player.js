@@ -112,7 +112,7 @@
 
   // ---- subtitle -------------------------------------------------------------------
   const sub = [];
-  if (ground) sub.push('slope ' + (ground.slope * 180 / Math.PI).toFixed(2) + '°');
+  if (ground && ground.slope) sub.push('slope ' + (ground.slope * 180 / Math.PI).toFixed(2) + '°');
   sub.push(F + ' frames');
   $('subtitle').textContent = sub.join(' · ');
 
