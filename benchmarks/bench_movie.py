@@ -1,8 +1,8 @@
 """Movies: a GIF and an MP4 of the compass gait walking for about 7 s (10 steps, 25 fps GIF /
 30 fps MP4, 500 × 400 px), written by ``amble.animate``, beside matplotlib's own
 ``FuncAnimation.save`` of the same figure (the usual way, and amble's earlier writer) in the same
-run. Times are wall-clock medians (and amble's CPU time, which load on the machine inflates less) over ``REPEATS`` runs, interleaved, the walk simulated once
-beforehand; the files' frame counts are checked equal.
+run. Times are wall-clock medians (and amble's CPU time, which load on the machine inflates
+less) over ``REPEATS`` runs, interleaved, the walk simulated once beforehand.
 
 Run alone: ``python -m benchmarks --only movie --no-write``.
 """
@@ -45,9 +45,8 @@ def _matplotlib_save(traj: Any, path: Path, fps: float) -> None:
 
 def run(quick: bool = False) -> Section:
     import amble
-    from amble.viz.movie import ffmpeg_path
-
     from amble.models import load
+    from amble.viz.movie import ffmpeg_path
 
     walker = load("compass-gait")
     traj = amble.simulate(walker, steps=4 if quick else 10)
