@@ -123,6 +123,28 @@ class Section:
         d = int(np.sum(s > RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
         return U[:, :d]
 
+    def increments(self, S: Sequence[int]) -> np.ndarray | None:
+        """``E`` (n × d) of the chart with coordinates ``S`` at the reference: the tangent vector
+        of Σ whose coordinates ``S`` are those of a chart increment (``E[S, :] = I``), as
+        :func:`chart` gives it for the same ``S``, without an orthonormal basis: any basis ``B``
+        of the tangent space gives ``E = B B[S, :]⁻¹``, and ``DΔ`` of a basis of ``ker ∇g`` is one
+        when the reset keeps the guard surface's dimension. ``None`` when it does not (the reset
+        collapses directions), when ``∇g = 0``, or when ``S`` does not chart Σ here."""
+        grad, D = self._jac(self.pre)
+        S = np.asarray(S, dtype=int)
+        m = int(np.argmax(np.abs(grad)))
+        if len(S) != grad.size - 1 or not grad[m] != 0.0:
+            return None
+        # ker ∇g: e_j − (g_j / g_m) e_m for every j ≠ m (coefficients at most 1 in size)
+        N = np.delete(np.eye(grad.size), m, axis=1)
+        N[m, :] = -np.delete(grad, m) / grad[m]
+        B = D @ N
+        try:
+            E = np.linalg.solve(B[S, :].T, B.T).T
+        except np.linalg.LinAlgError:
+            return None
+        return E if np.all(np.isfinite(E)) else None
+
     @property
     def dimension(self) -> int:
         """``d``, the dimension of the section (the number of section coordinates)."""
