@@ -135,12 +135,11 @@ class Section:
         m = int(np.argmax(np.abs(grad)))
         if len(S) != grad.size - 1 or not grad[m] != 0.0:
             return None
-        # ker ∇g: e_j − (g_j / g_m) e_m for every j ≠ m (coefficients at most 1 in size)
-        N = np.delete(np.eye(grad.size), m, axis=1)
-        N[m, :] = -np.delete(grad, m) / grad[m]
-        B = D @ N
+        # DΔ of a basis of ker ∇g, e_j − (g_j / g_m) e_m for every j ≠ m (coefficients at most 1)
+        rest = [j for j in range(grad.size) if j != m]
+        B = D[:, rest] - np.outer(D[:, m], grad[rest] / grad[m])
         try:
-            E = np.linalg.solve(B[S, :].T, B.T).T
+            E = B @ np.linalg.inv(B[S, :])
         except np.linalg.LinAlgError:
             return None
         return E if np.all(np.isfinite(E)) else None
