@@ -89,7 +89,7 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
     code += (f"            for (int l = 0; l < {n}; ++l)\n"
              f"                r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n")
     code += f"            dF[i * {nv} + v] = r;\n        }}\n"
-    code += f"    amble_chol_apply({n}, M, dF, {nv});\n"
+    code += f"    amble_chol_apply_rows({n}, M, dF, {nv});\n"
     code += f"    for (int i = 0; i < {n}; ++i) {{\n"
     if of_params:
         code += (f"        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
