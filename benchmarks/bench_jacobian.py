@@ -3,7 +3,7 @@ equations of the state columns and the saltation matrices, which also records it
 for the section's chart) against central differences (2d runs for a d-dimensional section, and
 one for the chart), both in units of one plain return-map evaluation measured in the same run
 (medians of interleaved repeats). Each includes the chart and the multipliers'
-eigen-decomposition (d ≤ 13, microseconds). "∂P/∂x alone" is ``ReturnMap.derivatives``: the
+eigen-decomposition (d ≤ 13, microseconds). "∂P/∂x alone" is `ReturnMap.derivatives`: the
 full-state derivative without the chart.
 """
 
