@@ -117,3 +117,14 @@ def test_only_long_derivative_kernels_are_compiled_unoptimised():
     assert _unoptimised(short) == short
     long = short + " " * OPTIMISE_LIMIT
     assert '#pragma GCC optimize ("O0")' in _unoptimised(long) and _unoptimised(long).count(long) == 1
+
+
+@pytest.mark.parametrize("name", ["compass-gait", "simplest-walker", "rimless-wheel"])
+def test_increments_are_the_chart_of_the_orthonormal_basis(name):
+    """E without an SVD (compass gait, rimless wheel) and where the reset collapses directions of
+    the guard surface (the simplest walker's massless swing leg): E of chart(tangent())."""
+    system = load(name)
+    lc = find_fixed_point(system)
+    sec = Section.of(ReturnMap(system, lc.parameters), lc.fixed_point)
+    S, E = chart(sec.tangent())
+    assert np.max(np.abs(sec.increments(S) - E)) < 1e-12 * max(1.0, np.max(np.abs(E)))

@@ -192,6 +192,7 @@ class ReturnMap:
         kept = self._charts.get(key)
         if kept is not None:
             E = sec.increments(kept[0])
+            # (a NaN or infinite entry fails the comparison too)
             if E is not None and float(np.max(np.abs(E))) <= CHART_GROWTH * kept[1]:
                 return kept[0], E
         S, E = _chart(sec.tangent())
