@@ -151,7 +151,7 @@ class _Problem:
     def F(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``F(u)`` and ``[F_x F_λ]`` (n × n+1)."""
         self.at(u[-1])
-        Px, _, s = self.P.derivatives(u[:-1])
+        Px, _, s = self.P.derivatives(u[:-1], params=True)
         J = np.hstack([s.dx_dx0 - np.eye(self.n), s.dx_dp[:, [self.j]]])
         return Px - u[:-1], J
 

@@ -71,7 +71,7 @@ def gait_gradients(cycle: LimitCycle, parameters: Sequence[str] | None = None, *
     if unknown:
         raise StateError(f"unknown parameter(s) {', '.join(unknown)}; parameters: {', '.join(names)}")
     cols = [names.index(n) for n in chosen]
-    _, _, s = P.derivatives(cycle.fixed_point)
+    _, _, s = P.derivatives(cycle.fixed_point, params=True)
     n = cycle.fixed_point.size
     try:
         dx = np.linalg.solve(np.eye(n) - s.dx_dx0, s.dx_dp[:, cols])

@@ -125,7 +125,7 @@ class _Path:
         """``F(u)``, ``[F_x F_s]`` (n × n+1), the step time ``T`` and ``[T_x T_s]``."""
         s = float(u[-1])
         self.P.p = self.params(s)
-        Px, T, sens = self.P.derivatives(u[:-1])
+        Px, T, sens = self.P.derivatives(u[:-1], params=True)
         dp = self.dparams(s)
         J = np.hstack([sens.dx_dx0 - np.eye(self.n), (sens.dx_dp @ dp)[:, None]])
         dT = np.r_[sens.dt_dx0, float(sens.dt_dp @ dp)]

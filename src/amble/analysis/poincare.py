@@ -98,6 +98,10 @@ MAX_PERIOD = 64
 #: motion of amplitude θ ≈ 1e-4 has a return-map residual below any tolerance while it decays
 #: towards rest (its largest multiplier is 1 − O(θ²)): such a "fixed point" is not a gait.
 REST_FRACTION = 1e-3
+#: The kept chart coordinates of a section are picked again when the largest entry of ``E`` (the
+#: state increment per unit chart increment) grows past this multiple of its size where they were
+#: picked: they still chart the section, but worse than the pivoting would choose.
+CHART_GROWTH = 4.0
 
 
 class ReturnMap:
@@ -126,6 +130,8 @@ class ReturnMap:
         mst = system.max_step_time
         self.opts = Options(rtol=rtol, atol=atol, max_step_time=mst)
         self.n = self.k.meta["nx"][self.mi]
+        #: the section's chart coordinates per (parameters, footfall transition), see _chart
+        self._charts: dict[tuple[bytes, int], tuple[np.ndarray, float]] = {}
 
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, float]:
         r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts)
@@ -135,11 +141,21 @@ class ReturnMap:
             raise SimulationError("return map: the walker did not come back to the section's mode")
         return r.x, r.t
 
-    def derivatives(self, x: np.ndarray, params: bool = True) -> tuple[np.ndarray, float, Sensitivity]:
-        """``P(x)``, the elapsed time and the exact derivatives of both with respect to ``x`` and
-        (with ``params``) the parameters: one compiled run with the variational equations."""
+    def derivatives(self, x: np.ndarray, params: bool = False) -> tuple[np.ndarray, float, Sensitivity]:
+        """``P(x)``, the elapsed time and the exact derivatives of both with respect to ``x`` and,
+        with ``params``, the parameters (else ``dx_dp`` and ``dt_dp`` have no columns): one
+        compiled run with the variational equations. Parameter columns are asked for only where
+        they are used, since the parameters enter most of a model's expressions (they cost a
+        kneed biped's run as much again as the state columns)."""
+        Px, t, s, _ = self._sensitivity_run(x, params, impact=False)
+        return Px, t, s
+
+    def _sensitivity_run(self, x: np.ndarray, params: bool, impact: bool
+                         ) -> tuple[np.ndarray, float, Sensitivity, tuple[int, float, np.ndarray] | None]:
+        """:meth:`derivatives` and, with ``impact``, the last footfall of the same run (as
+        :meth:`last_impact`): its events are recorded, not its samples."""
         r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts,
-                sensitivities=True if params else "state")
+                sensitivities=True if params else "state", record=impact, events_only=impact)
         if not r.completed:
             raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
         if r.mode != self.mi:
@@ -148,27 +164,58 @@ class ReturnMap:
         assert s is not None
         if not (np.all(np.isfinite(s.dx_dx0)) and np.all(np.isfinite(s.dx_dp))):
             raise SimulationError("return map: an event grazes its guard (ġ = 0), the map is not differentiable here")
-        return r.x, r.t, s
+        return r.x, r.t, s, self._last_step(r.recorded) if impact else None
 
     def section_jacobian(self, x: np.ndarray, method: str = "exact") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The map's Jacobian ``A`` in the section chart at ``x`` (its eigenvalues at a fixed
         point are the nontrivial multipliers), the chart's state coordinates ``S`` and ``E``,
-        the map from chart increments to state increments. ``method``: ``"exact"`` or ``"fd"``."""
-        S, E = _chart(self.section_basis(x))
-        return _jacobian(self, x, E, S, method), S, E
+        the map from chart increments to state increments. ``method``: ``"exact"`` or ``"fd"``.
+
+        ``"exact"`` is one compiled run: the variational equations of the state columns, and the
+        last footfall recorded in the same run, from which the section's tangent space is found.
+        The chart's coordinates ``S`` are kept per parameters and footfall transition (the
+        pivoting that picks them is most of the cost of a small model's chart); ``E`` is worked
+        out at every state, and the coordinates are picked again when the kept ones chart the
+        section here much worse than where they were picked."""
+        if method != "exact":
+            S, E = self._chart(Section.of(self, x))
+            return _jacobian(self, x, E, S, method), S, E
+        _, _, s, impact = self._sensitivity_run(x, False, impact=True)
+        assert impact is not None
+        S, E = self._chart(Section(self.k, self.p, *impact))
+        return (s.dx_dx0 @ E)[S, :], S, E
+
+    def _chart(self, sec: Section) -> tuple[np.ndarray, np.ndarray]:
+        """``(S, E)`` of the section ``sec``: :func:`amble.analysis.section.chart` of its tangent
+        space, ``S`` kept per (parameters, transition) as :meth:`section_jacobian` says."""
+        key = (self.p.tobytes(), sec.tr)
+        kept = self._charts.get(key)
+        if kept is not None:
+            E = sec.increments(kept[0])
+            # (a NaN or infinite entry fails the comparison too)
+            if E is not None and float(np.max(np.abs(E))) <= CHART_GROWTH * kept[1]:
+                return kept[0], E
+        S, E = _chart(sec.tangent())
+        if len(self._charts) >= 16:  # a continuation moves the parameters at every point
+            self._charts.clear()
+        self._charts[key] = (S, float(np.max(np.abs(E))))
+        return S, E
 
     def last_impact(self, x: np.ndarray) -> tuple[int, float, np.ndarray]:
         """(transition index, time, pre-event state) of the last footfall when mapping ``x``."""
         r = run(self.k, self.p, self.mi, np.asarray(x, float), steps=self.period, opts=self.opts, record=True,
-                sample_dt=1e9)
+                events_only=True)
         if not r.completed:
             raise SimulationError(f"return map: the run did not complete {self.period} step(s) ({r.status})")
-        rec = r.recorded
-        steps = [i for i, tr in enumerate(rec["etr"]) if self.k.meta["transitions"][int(tr)]["step"]]
-        i = steps[-1]
-        src = self.k.meta["transitions"][int(rec["etr"][i])]["source"]
-        nsrc = self.k.meta["nx"][self.k.mode_index(src)]
-        return int(rec["etr"][i]), float(rec["et"][i]), rec["epre"][i][:nsrc].copy()
+        return self._last_step(r.recorded)
+
+    def _last_step(self, rec: dict[str, Any]) -> tuple[int, float, np.ndarray]:
+        """(transition index, time, pre-event state) of the last step transition recorded."""
+        trs = self.k.meta["transitions"]
+        i = [j for j, tr in enumerate(rec["etr"].tolist()) if trs[tr]["step"]][-1]
+        tr = int(rec["etr"][i])
+        nsrc = self.k.meta["nx"][self.k.mode_index(trs[tr]["source"])]
+        return tr, float(rec["et"][i]), rec["epre"][i][:nsrc].copy()
 
     def section_basis(self, x: np.ndarray) -> np.ndarray:
         """Orthonormal basis (n × d) of the section's tangent space near the image of ``x``."""

@@ -123,6 +123,30 @@ class Section:
         d = int(np.sum(s > RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
         return U[:, :d]
 
+    def increments(self, S: Sequence[int]) -> np.ndarray | None:
+        """``E`` (n × d) of the chart with coordinates ``S`` at the reference: the tangent vector
+        of Σ whose coordinates ``S`` are those of a chart increment (``E[S, :] = I``), as
+        :func:`chart` gives it for the same ``S``. Any basis ``B`` of the tangent space gives
+        ``E = B B[S, :]⁻¹``; ``DΔ`` of a basis of ``ker ∇g`` is one when the reset keeps the
+        guard surface's dimension (no SVD), else the orthonormal basis of :meth:`tangent`.
+        ``None`` when ``S`` does not chart Σ here (``B[S, :]`` singular, or the wrong number of
+        coordinates); entries may be huge or not finite when it charts Σ badly."""
+        grad, D = self._jac(self.pre)
+        S = np.asarray(S, dtype=int)
+        m = int(np.argmax(np.abs(grad)))
+        if len(S) == grad.size - 1 and grad[m] != 0.0:
+            # e_j − (g_j / g_m) e_m for every j ≠ m: a basis of ker ∇g (coefficients at most 1)
+            rest = [j for j in range(grad.size) if j != m]
+            B = D[:, rest] - np.outer(D[:, m], grad[rest] / grad[m])
+        else:  # the reset collapses directions (or ∇g = 0): an orthonormal basis of its image
+            B = self.tangent()
+            if B.shape[1] != len(S):
+                return None
+        try:
+            return B @ np.linalg.inv(B[S, :])
+        except np.linalg.LinAlgError:
+            return None
+
     @property
     def dimension(self) -> int:
         """``d``, the dimension of the section (the number of section coordinates)."""

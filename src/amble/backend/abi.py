@@ -10,6 +10,8 @@ of misread.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 from .digest import sha256
 
 #: Run status codes: (code, C name, outcome name). Outcome ``None``: not an end of the run (the
@@ -94,6 +96,7 @@ SENS_FIELDS: tuple[tuple[str, tuple[int, int, int]], ...] = (
 )
 
 
+@lru_cache(maxsize=1)
 def _sens_offsets() -> dict[str, tuple[int, int, int]]:
     """Offset of each sensitivity field, and ``SIZE`` (the whole buffer), as coefficients."""
     out, acc = {}, (0, 0, 0)
@@ -104,6 +107,7 @@ def _sens_offsets() -> dict[str, tuple[int, int, int]]:
     return out
 
 
+@lru_cache(maxsize=64)  # asked by every sensitivity run, with a library's one shape
 def sens_layout(nx_max: int, sc: int) -> dict[str, int]:
     """Offsets (entries of float64) of the sensitivity fields in the buffer of a library with
     longest state ``nx_max`` and ``sc`` columns per sensitivity row, and ``SIZE``, its length."""

@@ -51,6 +51,7 @@ class _Program:
         self.lines: list[str] = []
         self.indent = indent
         self.memo: dict[sp.Basic, _Node] = {}
+        self.trig: dict[tuple[str, str], str] = {}
         self.count = 0
 
     def _new(self, expr: str) -> str:
@@ -58,6 +59,16 @@ class _Program:
         self.count += 1
         self.lines.append(f"{self.indent}const double {name} = {expr};")
         return name
+
+    def _trig(self, fn: str, arg: str) -> str:
+        """The name of ``fn(arg)``, computed once: a sine's derivative is the cosine of the same
+        argument, which the program often has already (GCC does not merge two calls of ``sin``
+        itself, since they may set ``errno``; a sine and a cosine of one argument it computes
+        together with ``sincos``)."""
+        key = (fn, arg)
+        if key not in self.trig:
+            self.trig[key] = self._new(f"{fn}({arg})")
+        return self.trig[key]
 
     def _children(self, e: sp.Basic) -> Sequence[sp.Basic]:
         if e in self.defs:
@@ -101,13 +112,11 @@ class _Program:
             return _Node(value, {i: self._new(_times(d, f"({dcoef})")) for i, d in b.tan.items()})
         if isinstance(e, (sp.sin, sp.cos)):
             a = kids[0]
-            value = self._new(f"{'sin' if isinstance(e, sp.sin) else 'cos'}({a.value})")
-            if isinstance(e, sp.sin):
-                dcoef = f"cos({a.value})"
-            else:
-                dcoef = f"(-sin({a.value}))"
-            if a.tan:
-                dcoef = self._new(dcoef)
+            is_sin = isinstance(e, sp.sin)
+            value = self._trig("sin" if is_sin else "cos", a.value)
+            if not a.tan:
+                return _Node(value, {})
+            dcoef = self._trig("cos", a.value) if is_sin else f"(-{self._trig('sin', a.value)})"
             return _Node(value, {i: self._new(_times(d, dcoef)) for i, d in a.tan.items()})
         # any other function (Piecewise, Min, Abs, atan2, …): printed whole, differentiated by
         # sympy in the symbols that carry derivatives (such nodes are small: controllers, limits)

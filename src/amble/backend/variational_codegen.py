@@ -89,7 +89,7 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
     code += (f"            for (int l = 0; l < {n}; ++l)\n"
              f"                r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n")
     code += f"            dF[i * {nv} + v] = r;\n        }}\n"
-    code += f"    amble_chol_apply({n}, M, dF, {nv});\n"
+    code += f"    amble_chol_apply_rows({n}, M, dF, {nv});\n"
     code += f"    for (int i = 0; i < {n}; ++i) {{\n"
     if of_params:
         code += (f"        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
@@ -205,20 +205,16 @@ def derivative_kernels(modes: dict[str, ModeInfo], order: list, trs_by_mode: dic
                        switches: dict[str, list[sp.Expr]], params: list[str]) -> str:
     """All derivative kernels of a system and their dispatchers (``rhs_jac``, ``rhs_jacp``,
     ``surfaces_grad``, ``reset_jac``)."""
-    # Their straight-line code is an order of magnitude longer than the right-hand side's, and
-    # GCC's optimiser is superlinear in the length of a basic block (humanoid-3d: 8 s → 63 s at
-    # -O2); unoptimised they compile in seconds and cost a sensitivity run about 1.5× more.
-    out = ["#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC push_options\n"
-           "#pragma GCC optimize (\"O0\")\n#endif\n"]
+    kernels = []
     for name, mi in modes.items():
         nm = symbol_names(mi.model, params)
         surf = [sp.sympify(tr.guard.expr) for tr in trs_by_mode[name]] + list(switches[name])
-        out.append(rhs_jacobian_code(mi, nm, params))
-        out.append(surfaces_gradient_code(mi, surf, nm, params))
+        kernels.append(rhs_jacobian_code(mi, nm, params))
+        kernels.append(surfaces_gradient_code(mi, surf, nm, params))
     for i, tr in enumerate(order):
-        out.append(reset_jacobian_code(i, tr, modes[tr.source], modes, symbol_names(modes[tr.source].model, params),
-                                       params))
-    out.append("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC pop_options\n#endif\n")
+        kernels.append(reset_jacobian_code(i, tr, modes[tr.source], modes, symbol_names(modes[tr.source].model, params),
+                                           params))
+    out = [_unoptimised("".join(kernels))]
     counts = {"mode": len(modes), "tr": len(order)}
     for ret, sig, key, call in _SIGNATURES:
         ret_kw, brk = ("return ", "") if ret != "void" else ("", " break;")
@@ -226,6 +222,27 @@ def derivative_kernels(modes: dict[str, ModeInfo], order: list, trs_by_mode: dic
         out.append(f"static {ret} {sig} {{\n    switch ({key}) {{\n{cases}    }}\n"
                    + ("    return -1;\n" if ret != "void" else "") + "}\n")
     return "".join(out)
+
+
+#: Derivative kernels of up to this many characters of C are compiled with the unit's flags
+#: (``-O2``); longer ones unoptimised. Their straight-line code is an order of magnitude longer
+#: than the right-hand side's and GCC's optimiser is superlinear in the length of a basic block.
+#: Measured (``gcc -O2`` of the whole unit, seconds, idle machine; the characters are those of
+#: the kernels): compass gait (36 k) 1.1 at O0 / 1.4 optimised, kneed biped (150 k) 2.2 / 2.9,
+#: humanoid-2d (195 k) 2.8 / 3.7, kuo-3d (310 k) 3.5 / 9.3, humanoid-3d (643 k) 7 / 21 at O1 and
+#: 63 at O2. Optimised, the kernels make a sensitivity run of the compass gait or the kneed biped
+#: about 1.5× faster: worth a second of build below the limit, not a minute above it.
+OPTIMISE_LIMIT = 250_000
+
+
+def _unoptimised(code: str) -> str:
+    """``code`` as it is below :data:`OPTIMISE_LIMIT` characters, else wrapped so that GCC
+    compiles it at ``-O0``."""
+    if len(code) <= OPTIMISE_LIMIT:
+        return code
+    return ("#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC push_options\n"
+            "#pragma GCC optimize (\"O0\")\n#endif\n" + code
+            + "#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC pop_options\n#endif\n")
 
 
 def derivative_stubs() -> str:

@@ -233,12 +233,19 @@ _AT_EVENT = (CODE["STEPS_DONE"], CODE["TERMINAL"], CODE["MAX_EVENTS"])
 
 def _sensitivity_buffer(k: Kernels, nx0: int, params: bool) -> np.ndarray:
     """``S = [I 0]`` (the initial state's own columns), ``dτ = 0`` and the numbers of state and
-    parameter columns carried, laid out by :func:`amble.backend.abi.sens_layout`."""
-    lay = sens_layout(k.nx_max, k.sc)
+    parameter columns carried, laid out by :func:`amble.backend.abi.sens_layout`: a copy of a
+    template kept per shape (laying it out costs more than a small model's run)."""
+    return _sensitivity_template(k.nx_max, k.sc, nx0, len(k.meta["params"]) if params else 0).copy()
+
+
+@lru_cache(maxsize=64)
+def _sensitivity_template(nx_max: int, sc: int, nx0: int, npar: int) -> np.ndarray:
+    lay = sens_layout(nx_max, sc)
     sens = np.zeros(lay["SIZE"])
-    S = sens[lay["S"] : lay["S"] + k.nx_max * k.sc].reshape(k.nx_max, k.sc)
+    S = sens[lay["S"] : lay["S"] + nx_max * sc].reshape(nx_max, sc)
     S[np.arange(nx0), np.arange(nx0)] = 1.0
-    sens[lay["NCS"]], sens[lay["NCP"]] = nx0, len(k.meta["params"]) if params else 0
+    sens[lay["NCS"]], sens[lay["NCP"]] = nx0, npar
+    sens.flags.writeable = False  # copied by every run
     return sens
 
 
@@ -248,17 +255,18 @@ def _sensitivity(k: Kernels, r: Run, sens: np.ndarray, nx0: int, p: np.ndarray) 
     npar = int(sens[lay["NCP"]])
     S = sens[lay["S"] : lay["S"] + nxm * sc].reshape(nxm, sc)[: r.x.size]
     tau = sens[lay["TAU"] : lay["TAU"] + sc]
-    cols = np.r_[np.arange(nx0), nxm + np.arange(npar)]
-    S, tau = S[:, cols], tau[cols]
+    dx_dx0, dt_dx0 = S[:, :nx0].copy(), tau[:nx0].copy()
+    dx_dp, dt_dp = S[:, nxm : nxm + npar].copy(), tau[nxm : nxm + npar].copy()
     if r.code in _AT_EVENT:
         # the buffer holds S at a fixed time just after the event: the state at the (moving)
         # event itself adds its flow times dτ
         f = k.rhs(r.mode, r.t, r.x, p)
-        S = S + np.outer(f, tau)
+        dx_dx0 += np.outer(f, dt_dx0)
+        if npar:
+            dx_dp += np.outer(f, dt_dp)
     else:
-        tau = np.zeros_like(tau)
-    return Sensitivity(dx_dx0=S[:, :nx0].copy(), dx_dp=S[:, nx0:].copy(), dt_dx0=tau[:nx0].copy(),
-                       dt_dp=tau[nx0:].copy())
+        dt_dx0[:], dt_dp[:] = 0.0, 0.0
+    return Sensitivity(dx_dx0=dx_dx0, dx_dp=dx_dp, dt_dx0=dt_dx0, dt_dp=dt_dp)
 
 
 def walk_many(k: Kernels, p: np.ndarray, mode: int, x0: np.ndarray, xref: np.ndarray, *, steps: int,

@@ -177,6 +177,30 @@ static void amble_chol_apply(int n, const double *L, double *B, int ncols) {
     }
 }
 
+/* amble_chol_apply for many columns: the same solve with the columns inner (contiguous rows,
+ * which the compiler vectorises) and one reciprocal of each pivot instead of a division per
+ * column (the derivative kernels solve for a column per state and parameter). */
+static void amble_chol_apply_rows(int n, const double *L, double *B, int ncols) {
+    for (int i = 0; i < n; ++i) {
+        double *bi = B + i * ncols;
+        for (int k = 0; k < i; ++k) {
+            const double l = L[i * n + k], *bk = B + k * ncols;
+            for (int c = 0; c < ncols; ++c) bi[c] -= l * bk[c];
+        }
+        const double r = 1.0 / L[i * n + i];
+        for (int c = 0; c < ncols; ++c) bi[c] *= r;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double *bi = B + i * ncols;
+        for (int k = i + 1; k < n; ++k) {
+            const double l = L[k * n + i], *bk = B + k * ncols;
+            for (int c = 0; c < ncols; ++c) bi[c] -= l * bk[c];
+        }
+        const double r = 1.0 / L[i * n + i];
+        for (int c = 0; c < ncols; ++c) bi[c] *= r;
+    }
+}
+
 /* LU factorisation with partial pivoting in place (piv: row swaps); AMBLE_ERR_SINGULAR_RESET on a
  * (near) zero pivot, with the threshold of amble_lu_solve. */
 static int amble_lu_factor(int n, double *A, int *piv) {

@@ -53,38 +53,76 @@ static void jac_times(int n, Cols cl, const double *J, const double *S, double *
     }
 }
 
+/* The carried columns of S (rows of SC) packed as n rows of nc = ncs + ncp contiguous columns,
+ * and back: the stage sums of a step then run over one contiguous array, which the compiler
+ * vectorises (the layout of the buffer, with its gap between state and parameter columns, it
+ * cannot). */
+static void sens_pack(int n, Cols cl, const double *S, double *P) {
+    const int nc = cl.ncs + cl.ncp;
+    for (int i = 0; i < n; ++i) {
+        for (int c = 0; c < cl.ncs; ++c) P[i * nc + c] = S[i * SC + c];
+        for (int c = 0; c < cl.ncp; ++c) P[i * nc + cl.ncs + c] = S[i * SC + NXMAX + c];
+    }
+}
+
+static void sens_unpack(int n, Cols cl, const double *P, double *S) {
+    const int nc = cl.ncs + cl.ncp;
+    for (int i = 0; i < n; ++i) {
+        for (int c = 0; c < cl.ncs; ++c) S[i * SC + c] = P[i * nc + c];
+        for (int c = 0; c < cl.ncp; ++c) S[i * SC + NXMAX + c] = P[i * nc + cl.ncs + c];
+    }
+}
+
+/* jac_times on packed columns: KS = J_x S + J_p, S and KS n × nc. */
+static void jac_times_packed(int n, Cols cl, const double *J, const double *S, double *KS) {
+    const int nc = cl.ncs + cl.ncp;
+    for (int i = 0; i < n; ++i) {
+        double *out = KS + i * nc;
+        const double *Ji = J + i * SC;
+        for (int c = 0; c < cl.ncs; ++c) out[c] = 0.0;
+        for (int c = 0; c < cl.ncp; ++c) out[cl.ncs + c] = Ji[NXMAX + c];
+        for (int k = 0; k < n; ++k) {
+            const double a = Ji[k];
+            if (a == 0.0) continue;
+            const double *row = S + k * nc;
+            for (int c = 0; c < nc; ++c) out[c] += a * row[c];
+        }
+    }
+}
+
+/* out = base + h Σ_{j<m} a_j K_j over w entries, the terms in the order of j (zeros of the
+ * tableau skipped: half of DOP853's are zero). */
+static void stage_sum(int w, int m, const double *a, double h, const double *base, const double *K, int ldk,
+                      double *out) {
+    double acc[w];
+    for (int e = 0; e < w; ++e) acc[e] = 0.0;
+    for (int j = 0; j < m; ++j) {
+        const double aj = a[j];
+        if (aj == 0.0) continue;
+        const double *Kj = K + j * ldk;
+        for (int e = 0; e < w; ++e) acc[e] += aj * Kj[e];
+    }
+    for (int e = 0; e < w; ++e) out[e] = base[e] + h * acc[e];
+}
+
 /* One step of (y, S) on tableau tb from (t0, y0, S) over h; S is overwritten, y1 gets the state. */
 static int sens_advance(const Tableau *tb, int mode, const double *p, Cols cl, double t0, double h, const double *y0,
                         double *S, double *y1) {
-    const int n = MODE_NX[mode], ns = tb->stages;
-    double K[ns][NXMAX], KS[ns][NXMAX * SC], J[NXMAX * SC];
-    double ytmp[NXMAX], Stmp[NXMAX * SC];
+    const int n = MODE_NX[mode], ns = tb->stages, w = n * (cl.ncs + cl.ncp);
+    double K[ns][NXMAX], KS[ns][w], J[NXMAX * SC];
+    double ytmp[NXMAX], S0[w], Stmp[w];
+    sens_pack(n, cl, S, S0);
     for (int st = 0; st < ns; ++st) {
         const double *a = tb->a + st * tb->stride;
-        for (int i = 0; i < n; ++i) {
-            double acc = 0.0;
-            for (int j = 0; j < st; ++j) acc += a[j] * K[j][i];
-            ytmp[i] = y0[i] + h * acc;
-            FOR_COLS(cl, c, {
-                double as = 0.0;
-                for (int j = 0; j < st; ++j) as += a[j] * KS[j][i * SC + c];
-                Stmp[i * SC + c] = S[i * SC + c] + h * as;
-            });
-        }
+        stage_sum(n, st, a, h, y0, &K[0][0], NXMAX, ytmp);
+        stage_sum(w, st, a, h, S0, &KS[0][0], w, Stmp);
         int err = sens_jac(mode, t0 + tb->c[st] * h, ytmp, p, cl, K[st], J);
         if (err) return err;
-        jac_times(n, cl, J, Stmp, KS[st]);
+        jac_times_packed(n, cl, J, Stmp, KS[st]);
     }
-    for (int i = 0; i < n; ++i) {
-        double acc = 0.0;
-        for (int j = 0; j < ns; ++j) acc += tb->b[j] * K[j][i];
-        y1[i] = y0[i] + h * acc;
-        FOR_COLS(cl, c, {
-            double as = 0.0;
-            for (int j = 0; j < ns; ++j) as += tb->b[j] * KS[j][i * SC + c];
-            S[i * SC + c] += h * as;
-        });
-    }
+    stage_sum(n, ns, tb->b, h, y0, &K[0][0], NXMAX, y1);
+    stage_sum(w, ns, tb->b, h, S0, &KS[0][0], w, Stmp);
+    sens_unpack(n, cl, Stmp, S);
     return 0;
 }
 
