@@ -116,5 +116,28 @@ class Slip:
         return roots
 
     def multiplier(self, y: float, h: float = 1e-5) -> float:
-        """dP/dy at ``y`` by central differences of the map (error ~ h²)."""
-        return (self.apex_map(y + h) - self.apex_map(y - h)) / (2 * h)
+        """dP/dy at ``y`` by a five-point central difference of the map (error ~ h⁴). Near the
+        touchdown height the map has a square-root singularity (the descent time grows as
+        sqrt(y − L0 sin(alpha))), so the step shrinks to a twentieth of the apex's height above it."""
+        h = min(h, (y - self.L0 * math.sin(self.alpha)) / 20)
+        P = self.apex_map
+        return (8 * (P(y + h) - P(y - h)) - (P(y + 2 * h) - P(y - 2 * h))) / (12 * h)
+
+    def gaits(self, n: int = 40) -> list[tuple[float, float]]:
+        """Every period-1 gait found on a grid of ``n`` apex heights: ``(apex height, dP/dy)``."""
+        return [(y, self.multiplier(y)) for y in self.fixed_point(n=n)]
+
+    def root_near(self, y: float, dy: float = 1e-4) -> float | None:
+        """The fixed point in ``[y - dy, y + dy]`` if ``P(y) - y`` changes sign there, else None
+        (``dy`` shrinks to half the apex's height above the touchdown height)."""
+        def F(z):
+            return self.apex_map(z) - z
+
+        dy = min(dy, (y - self.L0 * math.sin(self.alpha)) / 2)  # stay above the touchdown height
+        try:
+            a, b = F(y - dy), F(y + dy)
+        except ValueError:
+            return None
+        if a * b > 0:
+            return None
+        return brentq(F, y - dy, y + dy, xtol=1e-14, rtol=1e-14)
