@@ -83,6 +83,39 @@ class Slip:
                 "vx_next": vxl, "x_next": foot + px + vxl * t_rise, "liftoff_state": (px, py, vxl, vyl),
                 "stance_time": t_st}
 
+    def from_flight(self, x: float, y: float, xd: float, yd: float) -> dict:
+        """The stride from any flight state before touchdown (``x`` from the last apex, ``y`` the
+        height, velocities in m/s), not only from an apex on the energy level: the states just
+        after touchdown and lift-off in stance coordinates (the mass relative to the foot) and
+        at the next apex (``x`` measured from that apex, so 0), with their times (s). Ballistic
+        flight in closed form, stance as in :meth:`stride`."""
+        g, L0, a, k, m = self.g, self.L0, self.alpha, self.k, self.m
+        y_td = L0 * math.sin(a)
+        # y + yd t − g t²/2 = y_td, the later root (falling through the touchdown height)
+        t_td = (yd + math.sqrt(yd**2 + 2 * g * (y - y_td))) / g
+        td = (-L0 * math.cos(a), y_td, xd, yd - g * t_td)
+
+        def rhs(_t, s):
+            px, py, vx_, vy_ = s
+            r = math.hypot(px, py)
+            f = k * (L0 - r) / (m * r)
+            return [vx_, vy_, f * px, f * py - g]
+
+        def liftoff(_t, s):
+            return math.hypot(s[0], s[1]) - L0
+
+        liftoff.terminal, liftoff.direction = True, 1.0
+        sol = solve_ivp(rhs, (0.0, 5.0), td, method="DOP853", rtol=1e-13, atol=1e-13, events=liftoff,
+                        first_step=1e-6)
+        if sol.status != 1:
+            raise ValueError("no lift-off")
+        t_lo = t_td + float(sol.t_events[0][0])
+        lo = tuple(float(v) for v in sol.y_events[0][0])
+        t_rise = lo[3] / g
+        apex = (0.0, lo[1] + lo[3] ** 2 / (2 * g), lo[2], 0.0)
+        return {"touchdown": (t_td, np.array(td)), "liftoff": (t_lo, np.array(lo)),
+                "apex": (t_lo + t_rise, np.array(apex))}
+
     def apex_map(self, y: float) -> float:
         return self.stride(y)["y_next"]
 
