@@ -87,7 +87,8 @@ def build() -> HybridSystem:
     yt, ytd = th.q[0], th.qd[0]
     ground_force = k * (L + delta - yt) - c * ytd  # N: the spring and damper push the foot down
     s.transition("liftoff", "thrust", Guard(ground_force, -1), Explicit(q=[yt], qd=[ytd]), "flight")
-    s.transition("apex", "flight", Guard(yd, -1), same, "flight", step=True)
+    # ẏ = 0 exactly at the apex (the located root is within round-off of it): the section point
+    s.transition("apex", "flight", Guard(yd, -1), Explicit(q=[y], qd=[0]), "flight", step=True)
     for name, mode in (("fell", "compression"), ("fell_in_thrust", "thrust")):
         s.terminal(name, mode, Guard(s.modes[mode].q[0], -1), status="fell")
     s.default_start["flight"] = [0.8, 0.0]
