@@ -22,8 +22,9 @@ RUN = {"scheduler": "synchronous", "progress": False}
 
 
 def _check_rows(rows, scan: bool) -> dict:
-    """Compare each sweep row with the oracle; where amble found no gait the oracle's apex heights are scanned for a stable one, and with
-    ``scan`` also where amble found one (for a second stable gait)."""
+    """Compare each sweep row with the oracle; where amble found no gait the oracle's apex
+    heights are scanned for a stable one, and with ``scan`` also where amble found one (for a
+    second stable gait)."""
     seen = {"stable": 0, "unstable": 0, "failed": 0}
     for r in rows:
         o = Slip(k=r["k"], alpha=r["alpha"])
