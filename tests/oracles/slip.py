@@ -83,6 +83,39 @@ class Slip:
                 "vx_next": vxl, "x_next": foot + px + vxl * t_rise, "liftoff_state": (px, py, vxl, vyl),
                 "stance_time": t_st}
 
+    def from_flight(self, x: float, y: float, xd: float, yd: float) -> dict:
+        """The stride from any flight state before touchdown (``x`` from the last apex, ``y`` the
+        height, velocities in m/s), not only from an apex on the energy level: the states just
+        after touchdown and lift-off in stance coordinates (the mass relative to the foot) and
+        at the next apex (``x`` measured from that apex, so 0), with their times (s). Ballistic
+        flight in closed form, stance as in :meth:`stride`."""
+        g, L0, a, k, m = self.g, self.L0, self.alpha, self.k, self.m
+        y_td = L0 * math.sin(a)
+        # y + yd t − g t²/2 = y_td, the later root (falling through the touchdown height)
+        t_td = (yd + math.sqrt(yd**2 + 2 * g * (y - y_td))) / g
+        td = (-L0 * math.cos(a), y_td, xd, yd - g * t_td)
+
+        def rhs(_t, s):
+            px, py, vx_, vy_ = s
+            r = math.hypot(px, py)
+            f = k * (L0 - r) / (m * r)
+            return [vx_, vy_, f * px, f * py - g]
+
+        def liftoff(_t, s):
+            return math.hypot(s[0], s[1]) - L0
+
+        liftoff.terminal, liftoff.direction = True, 1.0
+        sol = solve_ivp(rhs, (0.0, 5.0), td, method="DOP853", rtol=1e-13, atol=1e-13, events=liftoff,
+                        first_step=1e-6)
+        if sol.status != 1:
+            raise ValueError("no lift-off")
+        t_lo = t_td + float(sol.t_events[0][0])
+        lo = tuple(float(v) for v in sol.y_events[0][0])
+        t_rise = lo[3] / g
+        apex = (0.0, lo[1] + lo[3] ** 2 / (2 * g), lo[2], 0.0)
+        return {"touchdown": (t_td, np.array(td)), "liftoff": (t_lo, np.array(lo)),
+                "apex": (t_lo + t_rise, np.array(apex))}
+
     def apex_map(self, y: float) -> float:
         return self.stride(y)["y_next"]
 
@@ -116,5 +149,28 @@ class Slip:
         return roots
 
     def multiplier(self, y: float, h: float = 1e-5) -> float:
-        """dP/dy at ``y`` by central differences of the map (error ~ h²)."""
-        return (self.apex_map(y + h) - self.apex_map(y - h)) / (2 * h)
+        """dP/dy at ``y`` by a five-point central difference of the map (error ~ h⁴). Near the
+        touchdown height the map has a square-root singularity (the descent time grows as
+        sqrt(y − L0 sin(alpha))), so the step shrinks to a twentieth of the apex's height above it."""
+        h = min(h, (y - self.L0 * math.sin(self.alpha)) / 20)
+        P = self.apex_map
+        return (8 * (P(y + h) - P(y - h)) - (P(y + 2 * h) - P(y - 2 * h))) / (12 * h)
+
+    def gaits(self, n: int = 40) -> list[tuple[float, float]]:
+        """Every period-1 gait found on a grid of ``n`` apex heights: ``(apex height, dP/dy)``."""
+        return [(y, self.multiplier(y)) for y in self.fixed_point(n=n)]
+
+    def root_near(self, y: float, dy: float = 1e-4) -> float | None:
+        """The fixed point in ``[y - dy, y + dy]`` if ``P(y) - y`` changes sign there, else None
+        (``dy`` shrinks to half the apex's height above the touchdown height)."""
+        def F(z):
+            return self.apex_map(z) - z
+
+        dy = min(dy, (y - self.L0 * math.sin(self.alpha)) / 2)  # stay above the touchdown height
+        try:
+            a, b = F(y - dy), F(y + dy)
+        except ValueError:
+            return None
+        if a * b > 0:
+            return None
+        return brentq(F, y - dy, y + dy, xtol=1e-14, rtol=1e-14)

@@ -30,7 +30,13 @@ class Printer(C99CodePrinter):
     Terms and factors are printed in the order the expression holds them (``order="none"``):
     sympy's default sorts every sum's terms first, which is most of the printing time of a large
     model (2.6× on the 30-DOF humanoid's intermediate quantities) and changes nothing but the order
-    of the additions."""
+    of the additions.
+
+    Constants (π, e, √2, 1/π, ...) are printed as their double values, never as the ``M_PI``
+    family of macros: those are not C99 (``<math.h>`` declares them only as an extension, which
+    ``-std=c99`` turns off), so a reset or guard holding ``sympy.pi`` would not compile."""
+
+    math_macros: dict = {}  # sympy reads this class attribute; empty: no macros
 
     def __init__(self, names: dict[sp.Symbol, str]) -> None:
         super().__init__(settings={"order": "none"})
@@ -48,6 +54,9 @@ class Printer(C99CodePrinter):
         return name if name is not None else super()._print_Symbol(expr)
 
     _print_Dummy = _print_Symbol
+
+    def _print_NumberSymbol(self, expr: sp.NumberSymbol) -> str:
+        return repr(float(expr))  # the nearest double: 17 significant digits read back exactly
 
     def _print_Pow(self, expr: sp.Pow) -> str:
         base, e = expr.base, expr.exp

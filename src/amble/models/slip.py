@@ -31,8 +31,8 @@ of stiffness ``k`` and rest length ``L0``. A stride is a directed cycle of three
   ``x_dot = sqrt(v0² + 2 g (y0 − y))``, which is the identity for an apex of a run on that level
   and reduces the return map to Seyfarth's one-dimensional apex-height map (the energy would
   otherwise be a neutral direction, a multiplier 1). The run's energy is set by ``y0`` and
-  ``v0``: start it on that level. Two flight domains (not one) keep a start at an apex from
-  counting as a stride.
+  ``v0``: start it on that level. A run started at an apex, in ``descent``, takes it as its
+  first section point and steps at the next apex.
 * the mass reaching the ground in stance, or a liftoff while still falling (no flight phase),
   ends the run (``fell``).
 

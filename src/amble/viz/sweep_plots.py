@@ -168,22 +168,30 @@ def _branch_id(row: Any) -> str | None:
 
 
 def _mark_branches(ax: Any, rows: Any, a: str, b: str) -> bool:
-    """Mark the cells whose fixed point lies on another branch than most of the map's: a colour
-    alone cannot tell two gaits of similar stability apart. Returns whether any cell was marked."""
+    """Mark the cells whose fixed point lies on another branch than most of its row's: a colour
+    alone cannot tell two gaits of similar stability apart. A map's row (one value of ``a``) is
+    one task that continues its gait along ``b`` and starts its branch ids afresh, so ids are
+    compared within a row only (across rows the same gait has different ids). Returns whether
+    any cell was marked."""
     ids = [(_branch_id(r), r) for r in rows if r["status"] == "ok"]
     ids = [(k, r) for k, r in ids if k is not None]
-    if not ids:
-        return False
-    values, counts = np.unique([k for k, _ in ids], return_counts=True)
-    if len(values) < 2:
-        return False
-    main = values[int(np.argmax(counts))]
-    for n, k in enumerate(v for v in values if v != main):
-        pts = np.array([(float(r[b]), float(r[a])) for kk, r in ids if kk == k])
-        ax.scatter(pts[:, 0], pts[:, 1], marker="x", s=28, color=f"C{(n + 1) % 10}", linewidths=1.2,
+    by_row: dict[str, list[tuple[str, Any]]] = {}
+    for k, r in ids:
+        by_row.setdefault(str(r["i"]), []).append((k, r))
+    marked: dict[str, list[tuple[float, float]]] = {}
+    for cells in by_row.values():
+        values, counts = np.unique([k for k, _ in cells], return_counts=True)
+        main = values[int(np.argmax(counts))]
+        for k, r in cells:
+            if k != main:
+                marked.setdefault(k, []).append((float(r[b]), float(r[a])))
+    for n, (k, pts) in enumerate(sorted(marked.items())):
+        xy = np.array(pts)
+        ax.scatter(xy[:, 0], xy[:, 1], marker="x", s=28, color=f"C{(n + 1) % 10}", linewidths=1.2,
                    label=f"branch {k}", gid="branch_change")
-    ax.legend(fontsize=7, loc="upper right", title=f"most cells: branch {main}", title_fontsize=7)
-    return True
+    if marked:
+        ax.legend(fontsize=7, loc="upper right", title="another branch than most of its row", title_fontsize=7)
+    return bool(marked)
 
 
 def plot_continuation(result: Any, path: str | os.PathLike, *, coordinate: str | None = None,

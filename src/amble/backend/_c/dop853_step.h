@@ -121,12 +121,12 @@ static int dop_step(Step *s, int mode, const double *p, double t_bound, double r
     double ha = *h_abs;
     if (ha > max_step) ha = max_step;
     if (ha < min_step) ha = min_step;
-    int rejected = 0, saw_nan = 0, aiming = sw0 != NULL && MODE_NSW[mode] > 0;
+    int rejected = 0, saw_nan = 0, saw_singular = 0, aiming = sw0 != NULL && MODE_NSW[mode] > 0;
     double ytmp[NXMAX], err_aimed = INFINITY; /* the error of the last aimed trial */
     const double ha0 = ha;
     *h_kink = 0.0;
     for (;;) {
-        if (ha < min_step) return saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
+        if (ha < min_step) return saw_singular ? ST_SINGULAR_MASS : saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
         double t_new = t + ha;
         if (t_new > t_bound) t_new = t_bound;
         double h = t_new - t;
@@ -136,16 +136,26 @@ static int dop_step(Step *s, int mode, const double *p, double t_bound, double r
         DOP_STEP_STAGE(1) DOP_STEP_STAGE(2) DOP_STEP_STAGE(3) DOP_STEP_STAGE(4) DOP_STEP_STAGE(5)
         DOP_STEP_STAGE(6) DOP_STEP_STAGE(7) DOP_STEP_STAGE(8) DOP_STEP_STAGE(9) DOP_STEP_STAGE(10)
         DOP_STEP_STAGE(11)
-        if (err) return ST_SINGULAR_MASS;
-        for (int i = 0; i < n; ++i) {
-            double a = 0.0;
-            DOP_B_TERMS(DOP_ADD_TERM)
-            s->y[i] = s->y_old[i] + h * a;
+        if (!err) {
+            for (int i = 0; i < n; ++i) {
+                double a = 0.0;
+                DOP_B_TERMS(DOP_ADD_TERM)
+                s->y[i] = s->y_old[i] + h * a;
+            }
+            /* the last stage, at the step's end: with the surfaces the event screening reads there */
+            err = g_new ? rhs_surfaces(mode, t + h, s->y, p, d->K[DOP_STAGES], g_new, gd_new)
+                        : rhs(mode, t + h, s->y, p, d->K[DOP_STAGES]);
         }
-        /* the last stage, at the step's end: with the surfaces the event screening reads there */
-        if (g_new ? rhs_surfaces(mode, t + h, s->y, p, d->K[DOP_STAGES], g_new, gd_new)
-                  : rhs(mode, t + h, s->y, p, d->K[DOP_STAGES]))
-            return ST_SINGULAR_MASS;
+        /* a trial stage outside the region where the mass matrix is positive definite (a stage
+         * extrapolates past the state the flow reaches) says the step is too long, not that the
+         * run must end: reject it as a non-finite one; only a singularity that persists down to
+         * the smallest step ends the run (ST_SINGULAR_MASS) */
+        if (err) {
+            saw_singular = 1;
+            ha *= 0.2;
+            rejected = 1;
+            continue;
+        }
         double e5 = 0.0, e3 = 0.0;
         for (int i = 0; i < n; ++i) {
             double a5 = 0.0, a3 = 0.0; /* the 5th- and the 3rd-order error estimates */

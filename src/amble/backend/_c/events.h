@@ -47,13 +47,18 @@ static int surf_enabled(int mode, int k, double t, const double *x, const double
  * restitution 0, or started there), the flow an instant later decides: accelerating across, it
  * fires again at once (and repeated zero-time events end the run as zeno) instead of sinking
  * through unseen. `fired`: index within the mode of a transition that has just fired into its
- * own mode; it sits on its own root and only the second test applies to it. */
+ * own mode; it sits on its own root and only the second test applies to it.
+ * `start`: the state is where the run starts (no transition yet). A step transition's guard is
+ * then left as it is: a run started on its section (an apex, a post-impact state) has that point
+ * as its first section point, and the step is the next crossing, not one at t = 0. Impacts and
+ * terminals are armed at the start too: a point started on the ground moving into it strikes it. */
 static void arm_zero_guards(int mode, double t, const double *x, const double *f, const double *p, int n,
-                            double *g, const double *gd, int fired) {
+                            double *g, const double *gd, int fired, int start) {
     double scale = 1.0;
     for (int i = 0; i < n; ++i) scale = fmax(scale, fabs(x[i]));
     for (int k = 0; k < MODE_NTR[mode]; ++k) {
         const int dir = TR_DIR[MODE_TR0[mode] + k];
+        if (start && TR_STEP[MODE_TR0[mode] + k]) continue;
         if (fabs(gd[k]) > 1e-12 * scale) {
             if (k == fired || g[k] != 0.0) continue;
             if (dir == 0 || (dir < 0) == (gd[k] < 0.0)) g[k] = gd[k] < 0.0 ? DBL_MIN : -DBL_MIN;

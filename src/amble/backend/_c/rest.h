@@ -45,7 +45,7 @@ static int come_to_rest(int tr, double t, const double *p, Step *s, int *mode, d
     if (rhs(target, t, s->y_old, p, s->f_old)) return ST_SINGULAR_MASS;
     surfaces(target, t, s->y_old, p, g_old);
     surfaces_dot(target, t, s->y_old, s->f_old, p, gd_old);
-    arm_zero_guards(target, t, s->y_old, s->f_old, p, s->n, g_old, gd_old, -1);
+    arm_zero_guards(target, t, s->y_old, s->f_old, p, s->n, g_old, gd_old, -1, 0);
     return -1;
 }
 

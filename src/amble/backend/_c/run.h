@@ -75,7 +75,9 @@ static int run_arm(Run *r) {
                                 s->n, s->m->error_order);
     surfaces(r->mode, r->t, s->y_old, r->p, r->g_old);
     surfaces_dot(r->mode, r->t, s->y_old, s->f_old, r->p, r->gd_old);
-    arm_zero_guards(r->mode, r->t, s->y_old, s->f_old, r->p, s->n, r->g_old, r->gd_old, -1);
+    /* no transition yet (a resumed call has had one, or left the start behind): the run's start */
+    const int start = r->ctx[CX_TPREV_EVENT] == -INFINITY;
+    arm_zero_guards(r->mode, r->t, s->y_old, s->f_old, r->p, s->n, r->g_old, r->gd_old, -1, start);
     r->h_resume = 0.0;
     int zs;
     if ((zs = resolve_zero_switches(r->mode, r->t, s->y_old, r->p, r->g_old, s->n, -1)) >= 0) {

@@ -62,7 +62,7 @@ static int after_transition(Run *r, int tr, int fired) {
     int st, zs;
     surfaces(r->mode, r->t, s->y_old, r->p, r->g_old);
     surfaces_dot(r->mode, r->t, s->y_old, s->f_old, r->p, r->gd_old);
-    arm_zero_guards(r->mode, r->t, s->y_old, s->f_old, r->p, s->n, r->g_old, r->gd_old, fired);
+    arm_zero_guards(r->mode, r->t, s->y_old, s->f_old, r->p, s->n, r->g_old, r->gd_old, fired, 0);
     if ((zs = resolve_zero_switches(r->mode, r->t, s->y_old, r->p, r->g_old, s->n, -1)) >= 0) {
         ctx[CX_INFO] = MODE_SW0[r->mode] + (zs - MODE_NTR[r->mode]);
         return ST_SLIDING;

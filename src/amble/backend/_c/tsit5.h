@@ -59,31 +59,40 @@ static int tsit5_step(Step *s, int mode, const double *p, double t_bound, double
     double ha = *h_abs, ytmp[NXMAX];
     if (ha > max_step) ha = max_step;
     if (ha < min_step) ha = min_step;
-    int rejected = 0, saw_nan = 0;
+    int rejected = 0, saw_nan = 0, saw_singular = 0;
     (void)sw0, (void)swd0;
     *h_kink = 0.0;
     for (;;) {
-        if (ha < min_step) return saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
+        if (ha < min_step) return saw_singular ? ST_SINGULAR_MASS : saw_nan ? ST_NONFINITE : ST_STEP_TOO_SMALL;
         double t_new = t + ha;
         if (t_new > t_bound) t_new = t_bound;
         const double h = t_new - t;
         ha = fabs(h);
         for (int i = 0; i < n; ++i) ts->K[0][i] = s->f_old[i];
-        for (int st = 1; st < TS_STAGES - 1; ++st) {
+        int bad = 0; /* a trial stage where M is singular: the step is too long (as in dop853_step.h) */
+        for (int st = 1; st < TS_STAGES - 1 && !bad; ++st) {
             const double *a = TS_A + st * TS_STAGES;
             for (int i = 0; i < n; ++i) {
                 double acc = 0.0;
                 for (int j = 0; j < st; ++j) acc += a[j] * ts->K[j][i];
                 ytmp[i] = s->y_old[i] + h * acc;
             }
-            if (rhs(mode, t + TS_C[st] * h, ytmp, p, ts->K[st])) return ST_SINGULAR_MASS;
+            bad = rhs(mode, t + TS_C[st] * h, ytmp, p, ts->K[st]);
         }
-        for (int i = 0; i < n; ++i) {
-            double acc = 0.0;
-            for (int j = 0; j < TS_STAGES - 1; ++j) acc += TS_B[j] * ts->K[j][i];
-            s->y[i] = s->y_old[i] + h * acc;
+        if (!bad) {
+            for (int i = 0; i < n; ++i) {
+                double acc = 0.0;
+                for (int j = 0; j < TS_STAGES - 1; ++j) acc += TS_B[j] * ts->K[j][i];
+                s->y[i] = s->y_old[i] + h * acc;
+            }
+            bad = rhs(mode, t + h, s->y, p, ts->K[TS_STAGES - 1]);
         }
-        if (rhs(mode, t + h, s->y, p, ts->K[TS_STAGES - 1])) return ST_SINGULAR_MASS;
+        if (bad) {
+            saw_singular = 1;
+            ha *= 0.2;
+            rejected = 1;
+            continue;
+        }
         double e2 = 0.0;
         for (int i = 0; i < n; ++i) {
             double acc = 0.0;
