@@ -48,35 +48,18 @@ from .poincare import find_fixed_point
 LINEAR_MAX_DIM = 3
 
 
-def quadrature(terrain: Terrain, nodes: int, rule: str = "gauss") -> tuple[dict[str, np.ndarray], np.ndarray]:
-    """Nodes and weights (summing to 1) of the terrain's law: ``nodes`` per drawn parameter.
-
-    ``rule``: ``"gauss"`` (Gauss–Hermite / Gauss–Legendre: exact for polynomials, but a fall is
-    a jump in the slope, which Gauss rules integrate no better than any other) or
-    ``"quantile"`` (the midpoints of ``nodes`` equally likely intervals, weights 1/nodes)."""
-    if rule not in ("gauss", "quantile"):
-        raise ParameterError(f"quadrature rule {rule!r} is not one of gauss, quantile")
-    axes, weights = [], []
-    for kind, a, b in terrain.draws.values():
-        if rule == "quantile":
-            from scipy.stats import norm
-
-            u = (np.arange(nodes) + 0.5) / nodes
-            axes.append(norm.ppf(u, a, b) if kind == "normal" else a + (b - a) * u)
-            weights.append(np.full(nodes, 1.0 / nodes))
-        elif kind == "normal":
-            x, w = np.polynomial.hermite_e.hermegauss(nodes)
-            axes.append(a + b * x)
-            weights.append(w / w.sum())
-        else:
-            x, w = np.polynomial.legendre.leggauss(nodes)
-            axes.append(0.5 * (a + b) + 0.5 * (b - a) * x)
-            weights.append(w / w.sum())
+def quadrature(terrain: Terrain, nodes: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Nodes and weights (summing to 1) of the terrain's law, ``nodes`` per drawn parameter: the
+    midpoints (in probability) of ``nodes`` equally likely intervals, a tensor product for several."""
+    axes = [_law(kind, a, b).ppf((np.arange(nodes) + 0.5) / nodes) for kind, a, b in terrain.draws.values()]
     grids = np.meshgrid(*axes, indexing="ij")
-    W = np.ones_like(grids[0])
-    for w, g in zip(weights, np.meshgrid(*weights, indexing="ij")):
-        W = W * g
-    return {n: g.ravel() for n, g in zip(terrain.draws, grids)}, W.ravel()
+    return {n: g.ravel() for n, g in zip(terrain.draws, grids)}, np.full(grids[0].size, 1.0 / grids[0].size)
+
+
+def _law(kind: str, a: float, b: float) -> Any:
+    from scipy.stats import norm, uniform
+
+    return norm(a, b) if kind == "normal" else uniform(a, b - a)
 
 
 @dataclass
@@ -116,20 +99,46 @@ class _Stepper:
 
     def __init__(self, k: Any, p0: np.ndarray, cols: list[int], draws: dict[str, np.ndarray], mode: int,
                  xref: np.ndarray, opts: Options, threads: int) -> None:
-        self.k, self.mode, self.xref, self.opts, self.threads = k, mode, xref, opts, threads
-        self.nq = len(next(iter(draws.values())))
-        self.P = np.tile(p0, (self.nq, 1))
-        for c, v in zip(cols, draws.values()):
-            self.P[:, c] = v
+        self.k, self.p0, self.cols, self.mode, self.xref, self.opts, self.threads = k, p0, cols, mode, xref, opts, threads
+        self.values = np.column_stack(list(draws.values()))
+        self.nq = len(self.values)
+
+    def walk(self, X: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One step of each row of ``X`` on its own row of drawn values: images and the mask of
+        steps that ended in a footfall."""
+        P = np.tile(self.p0, (len(X), 1))
+        P[:, self.cols] = values
+        out = walk_many(self.k, P, self.mode, X, self.xref, steps=1, check_every=1, tol=-1.0, opts=self.opts,
+                        threads=self.threads)
+        return out["x"][:, : X.shape[1]], out["code"] == CODE["STEPS_DONE"]
 
     def images(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Images (len(X) · nq rows, state-major) and the mask of steps that ended in a footfall."""
-        X0 = np.repeat(X, self.nq, axis=0)
-        P = np.tile(self.P, (len(X), 1))
-        out = walk_many(self.k, P, self.mode, X0, self.xref, steps=1, check_every=1, tol=-1.0, opts=self.opts,
-                        threads=self.threads)
-        ok = out["code"] == CODE["STEPS_DONE"]
-        return out["x"][:, : X.shape[1]], ok
+        """Images of every state on every node (len(X) · nq rows, state-major) and their mask."""
+        return self.walk(np.repeat(X, self.nq, axis=0), np.tile(self.values, (len(X), 1)))
+
+
+def _edges(step: _Stepper, law: Any, X: np.ndarray, ok: np.ndarray, bisections: int) -> np.ndarray:
+    """Node weights of one drawn parameter with the fall located between the nodes (rows: states).
+
+    A node owns its equally likely interval; where a node walks and its neighbour falls, the
+    parameter where the outcome changes is found by bisection (``bisections`` walks) and the
+    walking node owns the probability up to it, the falling one the rest: the fall, a jump in the
+    drawn parameter, is integrated to the bisection's resolution instead of to a node's width."""
+    n = step.nq
+    g = step.values[:, 0]
+    # the edges of the nodes' intervals, for every state: moved to the outcome's change below
+    cut = np.tile(law.ppf(np.arange(1, n) / n), (len(X), 1))
+    i, j = np.nonzero(ok[:, :-1] != ok[:, 1:])
+    if len(i):
+        lo, hi = np.full(len(i), g[j]), np.full(len(i), g[j + 1])
+        for _ in range(bisections):
+            mid = 0.5 * (lo + hi)
+            walks = step.walk(X[i], mid[:, None])[1]
+            same = walks == ok[i, j]  # the outcome of the left node: the change is to the right
+            lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        cut[i, j] = 0.5 * (lo + hi)
+    cdf = np.c_[np.zeros(len(X)), law.cdf(cut), np.ones(len(X))]
+    return np.diff(cdf, axis=1)
 
 
 def _grow(step: _Stepper, x0: np.ndarray, scale: np.ndarray, spacing: float, max_states: int) -> np.ndarray:
@@ -184,14 +193,17 @@ def _assign(mesh: np.ndarray, Y: np.ndarray, scale: np.ndarray, varying: np.ndar
     return idx, wts
 
 
-def _chain(step: _Stepper, mesh: np.ndarray, weights: np.ndarray, scale: np.ndarray,
-           varying: np.ndarray) -> _Chain:
+def _chain(step: _Stepper, mesh: np.ndarray, weights: np.ndarray, scale: np.ndarray, varying: np.ndarray,
+           law: Any, bisections: int) -> _Chain:
     from scipy.sparse import coo_matrix
 
     Y, ok = step.images(mesh)
     n, nq = len(mesh), step.nq
     src = np.repeat(np.arange(n), nq)
-    w = np.tile(weights, n)
+    if law is not None:
+        w = _edges(step, law, mesh, ok.reshape(n, nq), bisections).ravel()
+    else:
+        w = np.tile(weights, n)
     idx, wts = _assign(mesh, Y[ok], scale, varying)
     rows = np.repeat(src[ok], idx.shape[1])
     vals = (wts * w[ok][:, None]).ravel()
@@ -218,7 +230,7 @@ def _solve(c: _Chain) -> tuple[float, float, np.ndarray]:
 
 
 def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels: int = 3, nodes: int = 16,
-                max_states: int = 20_000, rule: str = "gauss", params: Mapping[str, float] | None = None,
+                max_states: int = 20_000, bisections: int = 12, params: Mapping[str, float] | None = None,
                 start: Sequence[float] | None = None, threads: int = 1, opts: Options | None = None) -> MarkovPassage:
     """The mean first-passage time to a fall on ``terrain`` from a Markov chain on a mesh of the
     section (module docstring).
@@ -227,7 +239,7 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
     ``levels``: chains built at ``spacing · 2^(levels−1)``, …, ``spacing`` (the convergence
     shown); ``nodes``: quadrature nodes per drawn parameter; ``max_states``: the mesh's cap;
     ``params``, ``start``, ``threads``, ``opts`` as for :func:`amble.analysis.mfpt.mfpt`."""
-    for name, v, low in (("levels", levels, 1), ("nodes", nodes, 1), ("max_states", max_states, 2),
+    for name, v, low in (("levels", levels, 1), ("nodes", nodes, 1), ("max_states", max_states, 2), ("bisections", bisections, 0),
                          ("threads", threads, 1)):
         if isinstance(v, bool) or not isinstance(v, int) or v < low:
             raise ParameterError(f"{name} must be an integer ≥ {low}, got {v!r}")
@@ -245,7 +257,8 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
         x0, mode = np.asarray(lc.fixed_point, float), k.mode_index(lc.mode)
     else:
         x0, mode = np.asarray(start, float), 0
-    draws, weights = quadrature(terrain, nodes, rule)
+    draws, weights = quadrature(terrain, nodes)
+    law = _law(*next(iter(terrain.draws.values()))) if len(terrain.draws) == 1 else None
     step = _Stepper(k, p0, [names.index(n) for n in terrain.draws], draws, mode, x0, opts or Options(), threads)
     # the scale of each coordinate: the spread of two steps' images of the gait
     Y1, ok1 = step.images(x0[None, :])
@@ -258,7 +271,7 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
     for lev in range(levels - 1, -1, -1):
         h = spacing * 2.0**lev
         mesh = _grow(step, x0, scale, h, max_states)
-        chain = _chain(step, mesh, weights, scale, varying)
+        chain = _chain(step, mesh, weights, scale, varying, law, bisections)
         m, lam, v = _solve(chain)
         out.append({"spacing": h, "states": len(mesh), "mfpt": m, "mfpt_eigen": 1.0 / (1.0 - lam)
                     if lam < 1 else math.inf, "metastable": v})

@@ -1,0 +1,44 @@
+"""The Markov-chain MFPT of the rimless wheel on stochastic slopes, against the converged chain on
+the wheel's scalar energy (tests/oracles/rimless_wheel_mfpt.py, nothing from amble)."""
+
+import pytest
+from analysis.test_mfpt import _wheel
+from oracles.rimless_wheel_mfpt import energy_mfpt
+
+from amble import ParameterError
+from amble.analysis.markov import markov_mfpt
+from amble.analysis.mfpt import Terrain
+
+
+def _check(mean, sd, **kw):
+    r = markov_mfpt(_wheel(), Terrain.parse(f"slope~normal({mean},{sd})"), **kw)
+    truth = energy_mfpt(mean, sd, 1000)
+    assert abs(r.mfpt - truth) / truth < 0.02, (r.mfpt, truth, r.levels)
+    return r
+
+
+@pytest.mark.parametrize("mean, sd", [(0.08, 0.02), (0.08, 0.03), (0.1, 0.05)])
+def test_the_rimless_wheels_markov_mfpt_is_that_of_its_energy_chain(mean, sd):
+    r = _check(mean, sd, nodes=32, spacing=0.05, levels=2)
+    # the refinement is shown: one value per spacing, each half the one before, the finest last
+    assert [lv["spacing"] for lv in r.levels] == [0.1, 0.05] and r.levels[-1]["mfpt"] == r.mfpt
+    assert r.levels[0]["states"] < r.levels[1]["states"] == r.states
+    assert r.ci_low <= r.mfpt <= r.ci_high
+    # the metastable distribution is a distribution on the mesh; from it the walker falls at 1 − λ₂
+    assert r.metastable.shape == (r.states,) and abs(r.metastable.sum() - 1) < 1e-12
+    assert 0 < r.lambda2 < 1 and r.mfpt_eigen == pytest.approx(1 / (1 - r.lambda2))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mean, sd", [(0.08, 0.04), (0.12, 0.05), (0.08, 0.015)])
+def test_more_slopes_of_the_rimless_wheel(mean, sd):
+    _check(mean, sd, nodes=32, spacing=0.05, levels=2)
+
+
+@pytest.mark.parametrize("kw, what", [
+    ({"nodes": 0}, "nodes"), ({"levels": 1.5}, "levels"), ({"spacing": -1.0}, "spacing"),
+    ({"bisections": -1}, "bisections"),
+])
+def test_bad_settings_are_refused(kw, what):
+    with pytest.raises(ParameterError, match=what):
+        markov_mfpt(_wheel(), Terrain.parse("slope~normal(0.08,0.03)"), **kw)
