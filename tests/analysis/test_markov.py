@@ -42,3 +42,22 @@ def test_more_slopes_of_the_rimless_wheel(mean, sd):
 def test_bad_settings_are_refused(kw, what):
     with pytest.raises(ParameterError, match=what):
         markov_mfpt(_wheel(), Terrain.parse("slope~normal(0.08,0.03)"), **kw)
+
+
+def test_the_command_line_gives_the_markov_estimate_its_levels_and_a_plot(capsys, tmp_path):
+    import json
+
+    from amble.cli.main import main
+
+    png = tmp_path / "metastable.png"
+    assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08,0.04)", "--method", "markov",
+                 "--nodes", "16", "--spacing", "0.2", "--levels", "2", "--plot", str(png), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["method"] == "markov" and d["ci_low"] <= d["mfpt"] <= d["ci_high"]
+    assert [lv["spacing"] for lv in d["levels"]] == [0.4, 0.2] and d["state_names"] == ["theta", "theta_dot"]
+    assert len(d["metastable"]["mean"]) == 2 and 0 < d["metastable"]["mode_probability"] <= 1
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    for bad in (["--spacing", "0"], ["--nodes", "0"], ["--plot", str(tmp_path / "x.txt")]):
+        assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08,0.04)", "--method", "markov", *bad]) == 2
+        assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08,0.04)", "--plot", str(png)]) == 2
