@@ -61,3 +61,30 @@ def test_the_command_line_gives_the_markov_estimate_its_levels_and_a_plot(capsys
         assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08,0.04)", "--method", "markov", *bad]) == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1
     assert main(["mfpt", "rimless-wheel", "--terrain", "slope~normal(0.08,0.04)", "--plot", str(png)]) == 2
+
+
+def _agree(terrain, runs, **kw):
+    """Monte Carlo and the chain on the compass gait: the chain's value at its finest level lies in
+    the Monte Carlo's 95 % interval widened by the chain's own discretisation spread (its levels)."""
+    from amble.analysis.mfpt import mfpt
+    from amble.cli.args import load_model
+
+    s = load_model("compass-gait")
+    mc = mfpt(s, Terrain.parse(terrain), runs=runs, seed=1, max_steps=2000)
+    chain = markov_mfpt(s, Terrain.parse(terrain), **kw)
+    spread = chain.ci_high - chain.ci_low
+    assert mc.ci_low - spread < chain.mfpt < mc.ci_high + spread, (chain.mfpt, chain.levels, mc.ci_low, mc.ci_high)
+    return mc, chain
+
+
+def test_the_compass_gaits_markov_and_monte_carlo_mfpt_agree():
+    _agree("slope~normal(0.0525,0.01)", 2000, nodes=16, spacing=0.2, levels=2, max_states=3000)
+
+
+def test_the_oracles_energy_chain_is_the_monte_carlo_of_its_map():
+    from oracles.rimless_wheel_mfpt import monte_carlo_mfpt
+
+    truth = energy_mfpt(0.08, 0.03, 1000)
+    assert abs(energy_mfpt(0.08, 0.03, 500) - truth) < 1e-3  # converged in the cells
+    mc = monte_carlo_mfpt(0.08, 0.03, 400_000, seed=3)  # standard error 0.17 %
+    assert abs(mc - truth) / truth < 0.007, (mc, truth)
