@@ -22,7 +22,7 @@ def test_the_rimless_wheels_markov_mfpt_is_that_of_its_energy_chain(mean, sd):
     r = _check(mean, sd, nodes=32, spacing=0.05, levels=2)
     # the refinement is shown: one value per spacing, each half the one before, the finest last
     assert [lv["spacing"] for lv in r.levels] == [0.1, 0.05] and r.levels[-1]["mfpt"] == r.mfpt
-    assert r.levels[0]["states"] < r.levels[1]["states"] == r.states
+    assert r.levels[0]["states"] < r.levels[1]["states"] == r.states and all(lv["complete"] for lv in r.levels)
     assert r.ci_low <= r.mfpt <= r.ci_high
     # the metastable distribution is a distribution on the mesh; from it the walker falls at 1 − λ₂
     assert r.metastable.shape == (r.states,) and abs(r.metastable.sum() - 1) < 1e-12
@@ -88,3 +88,8 @@ def test_the_oracles_energy_chain_is_the_monte_carlo_of_its_map():
     assert abs(energy_mfpt(0.08, 0.03, 500) - truth) < 1e-3  # converged in the cells
     mc = monte_carlo_mfpt(0.08, 0.03, 400_000, seed=3)  # standard error 0.17 %
     assert abs(mc - truth) / truth < 0.007, (mc, truth)
+
+
+def test_a_walker_on_ground_that_never_changes_never_falls():
+    r = markov_mfpt(_wheel(), Terrain.parse("slope~normal(0.08,0)"), nodes=4, levels=2)
+    assert r.mfpt == float("inf") and r.to_json()["mfpt"] is None and r.to_json()["levels"][0]["mfpt"] is None

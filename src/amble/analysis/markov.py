@@ -31,7 +31,9 @@ after its transient; it is reported as ``mfpt_eigen``, the distribution as ``met
 
 **Convergence.** The chain is built at ``levels`` spacings, each half the one before; the
 result carries the MFPT at every level, and its ``ci_low``/``ci_high`` are the two finest
-levels' values — a measure of the discretisation's error, not a confidence interval.
+levels' values — a measure of the discretisation's error, not a confidence interval. A level's
+``complete`` is false when its mesh was cut at ``max_states`` before every reachable state was
+meshed: images beyond it go to their nearest mesh state, and its value is not to be trusted.
 """
 
 from __future__ import annotations
@@ -57,15 +59,27 @@ LINEAR_MAX_DIM = 3
 def quadrature(terrain: Terrain, nodes: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
     """Nodes and weights (summing to 1) of the terrain's law, ``nodes`` per drawn parameter: the
     midpoints (in probability) of ``nodes`` equally likely intervals, a tensor product for several."""
-    axes = [_law(kind, a, b).ppf((np.arange(nodes) + 0.5) / nodes) for kind, a, b in terrain.draws.values()]
+    u = (np.arange(nodes) + 0.5) / nodes
+    axes = [np.full(nodes, float(a)) if _fixed(kind, a, b) else _law(kind, a, b).ppf(u)
+            for kind, a, b in terrain.draws.values()]
     grids = np.meshgrid(*axes, indexing="ij")
     return {n: g.ravel() for n, g in zip(terrain.draws, grids)}, np.full(grids[0].size, 1.0 / grids[0].size)
+
+
+def _fixed(kind: str, a: float, b: float) -> bool:
+    """A law of one value (no spread): its nodes are that value, and no fall is located between them."""
+    return b == 0 if kind == "normal" else a == b
 
 
 def _law(kind: str, a: float, b: float) -> Any:
     from scipy.stats import norm, uniform
 
     return norm(a, b) if kind == "normal" else uniform(a, b - a)
+
+
+def _finite(v: Any) -> Any:
+    """JSON has no infinity: a walker that never falls has MFPT ``null``."""
+    return None if isinstance(v, float) and not math.isfinite(v) else v
 
 
 @dataclass
@@ -90,7 +104,8 @@ class MarkovPassage:
     def to_json(self) -> dict[str, Any]:
         out = {k: getattr(self, k) for k in ("mfpt", "ci_low", "ci_high", "mfpt_eigen", "lambda2", "states",
                                                "spacing", "nodes", "levels", "method", "terrain")}
-        out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+        out = {k: _finite(v) for k, v in out.items()}
+        out["levels"] = [{k: _finite(v) for k, v in lv.items()} for lv in self.levels]
         return {**out, "metastable": self.metastable_summary()}
 
     def metastable_summary(self) -> dict[str, Any]:
@@ -160,8 +175,10 @@ def _edges(step: _Stepper, law: Any, X: np.ndarray, ok: np.ndarray, bisections: 
     return np.diff(cdf, axis=1)
 
 
-def _grow(step: _Stepper, x0: np.ndarray, scale: np.ndarray, spacing: float, max_states: int) -> np.ndarray:
-    """The mesh of reachable states: waves of new images farther than ``spacing`` from the mesh."""
+def _grow(step: _Stepper, x0: np.ndarray, scale: np.ndarray, spacing: float,
+          max_states: int) -> tuple[np.ndarray, bool]:
+    """The mesh of reachable states: waves of new images farther than ``spacing`` from the mesh;
+    and whether it is complete (no new image left when it stopped, not cut at ``max_states``)."""
     from scipy.spatial import cKDTree
 
     mesh = [x0[None, :]]
@@ -182,7 +199,7 @@ def _grow(step: _Stepper, x0: np.ndarray, scale: np.ndarray, spacing: float, max
         frontier = np.vstack(new) if new else np.empty((0, x0.size))
         count += len(frontier)
         mesh.append(frontier)
-    return np.vstack(mesh)
+    return np.vstack(mesh), len(frontier) == 0
 
 
 def _assign(mesh: np.ndarray, Y: np.ndarray, scale: np.ndarray, varying: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -231,13 +248,40 @@ def _chain(step: _Stepper, mesh: np.ndarray, weights: np.ndarray, scale: np.ndar
     return _Chain(mesh, Q, fall)
 
 
+def _falling(c: _Chain) -> np.ndarray:
+    """The states that fall with probability 1 (a finite MFPT): those that reach a fall and
+    cannot reach a state that never falls (on a mesh too coarse to see any fall, for one)."""
+    from scipy.sparse.csgraph import breadth_first_order
+
+    def reach(targets: np.ndarray, G: Any) -> np.ndarray:
+        # the states from which one of ``targets`` is reached: a search from a new node joined to them
+        n = G.shape[0]
+        from scipy.sparse import bmat, csr_matrix
+
+        link = csr_matrix((np.ones(int(targets.sum())), (np.zeros(int(targets.sum()), int),
+                                                          np.flatnonzero(targets))), shape=(1, n))
+        H = bmat([[csr_matrix((1, 1)), link], [csr_matrix((n, 1)), G]], format="csr")
+        order = breadth_first_order(H, 0, directed=True, return_predecessors=False)
+        out = np.zeros(n, bool)
+        out[order[order > 0] - 1] = True
+        return out
+
+    back = (c.Q.T > 0).astype(float).tocsr()  # edges reversed: a search finds predecessors
+    never = ~reach(c.fall > 0, back)
+    return ~reach(never, back) if never.any() else np.ones(len(never), bool)
+
+
 def _solve(c: _Chain) -> tuple[float, float, np.ndarray]:
     """MFPT from state 0, λ₂ (the largest eigenvalue of Q) and its left eigenvector, normalised."""
     from scipy.sparse import identity
     from scipy.sparse.linalg import eigs, spsolve
 
     n = c.Q.shape[0]
-    m = spsolve((identity(n, format="csc") - c.Q.tocsc()), np.ones(n))
+    finite = _falling(c)
+    m = np.full(n, math.inf)
+    if finite.any():
+        Qf = c.Q[finite][:, finite]
+        m[finite] = spsolve((identity(int(finite.sum()), format="csc") - Qf.tocsc()), np.ones(int(finite.sum())))
     if n > 2:
         vals, vecs = eigs(c.Q.T.tocsc(), k=1, which="LR", tol=1e-12, maxiter=20 * n)
         lam, v = float(vals[0].real), np.abs(vecs[:, 0].real)
@@ -277,7 +321,8 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
     else:
         x0, mode = np.asarray(start, float), 0
     draws, weights = quadrature(terrain, nodes)
-    law = _law(*next(iter(terrain.draws.values()))) if len(terrain.draws) == 1 else None
+    one = next(iter(terrain.draws.values()))
+    law = _law(*one) if len(terrain.draws) == 1 and not _fixed(*one) else None
     step = _Stepper(k, p0, [names.index(n) for n in terrain.draws], draws, mode, x0, opts or Options(), threads)
     # the scale of each coordinate: the spread of two steps' images of the gait
     Y1, ok1 = step.images(x0[None, :])
@@ -285,15 +330,17 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
     spread = np.vstack([Y1[ok1], Y2[ok2]]).std(axis=0) if ok1.any() else np.zeros_like(x0)
     ref = max(float(np.max(spread)), 1e-12)
     varying = spread > 1e-9 * ref
+    if not varying.any():  # every image is the gait: distances in every coordinate
+        varying[:] = True
     scale = np.where(varying, spread, ref)
     out, chain = [], None
     for lev in range(levels - 1, -1, -1):
         h = spacing * 2.0**lev
-        mesh = _grow(step, x0, scale, h, max_states)
+        mesh, complete = _grow(step, x0, scale, h, max_states)
         chain = _chain(step, mesh, weights, scale, varying, law, bisections)
         m, lam, v = _solve(chain)
-        out.append({"spacing": h, "states": len(mesh), "mfpt": m, "mfpt_eigen": 1.0 / (1.0 - lam)
-                    if lam < 1 else math.inf, "metastable": v})
+        out.append({"spacing": h, "states": len(mesh), "complete": complete, "mfpt": m,
+                    "mfpt_eigen": 1.0 / (1.0 - lam) if lam < 1 else math.inf, "metastable": v})
     fine = out[-1]
     other = out[-2]["mfpt"] if len(out) > 1 else fine["mfpt"]
     assert chain is not None

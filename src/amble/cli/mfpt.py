@@ -79,7 +79,8 @@ def _markov(args: argparse.Namespace, system: Any, terrain: Any, plot_p: Path | 
         write_output(plot_p, lambda part: plot_metastable(r, part, state_names=out["state_names"]), "--plot")
         out["plot"] = str(plot_p)
     if not args.json:
-        steps = ", ".join(f"{lv['mfpt']:.4g} ({lv['states']} states)" for lv in r.levels)
+        steps = ", ".join(f"{lv['mfpt']:.4g} ({lv['states']} states{'' if lv['complete'] else ', cut'})"
+                          for lv in r.levels)
         print(f"{system.name}: mean first-passage time {r.mfpt:.4g} steps (Markov chain; by refinement: {steps}; "
               f"from the metastable distribution {r.mfpt_eigen:.4g})")
     return out
