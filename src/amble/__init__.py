@@ -54,6 +54,7 @@ _WHERE: dict[str, str] = {
     "optimize_gait": ".analysis.gait_optimisation",
     **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
     **dict.fromkeys(("MarkovPassage", "markov_mfpt"), ".analysis.markov"),
+    **dict.fromkeys(("GaitSensitivity", "gait_sensitivity"), ".analysis.robustness"),
     "gait_gradients": ".analysis.gait_gradients",
     "check_gait": ".analysis.gait_check",
     "simulate": ".simulation.simulate",
