@@ -60,7 +60,7 @@ _WHERE: dict[str, str] = {
     "simulate": ".simulation.simulate",
     **dict.fromkeys(("Event", "Trajectory"), ".simulation.trajectory"),
     **dict.fromkeys(("animate", "plot_limit_cycle", "plot_trajectory"), ".viz"),
-    "plot_metastable": ".viz.metastable",
+    **dict.fromkeys(("plot_metastable", "plot_mfpt_against"), ".viz.metastable"),
 }
 
 __all__ = sorted(_WHERE, key=lambda n: (not n.isupper(), n))

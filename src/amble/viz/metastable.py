@@ -39,4 +39,29 @@ def plot_metastable(result: Any, path: str | os.PathLike, *, state_names: Sequen
     return _save(fig, path)
 
 
-__all__ = ["plot_metastable"]
+
+def plot_mfpt_against(values: Sequence[float], results: Sequence[Any], path: str | os.PathLike, *,
+                      label: str = "parameter", title: str | None = None) -> Path:
+    """MFPT (steps, log scale) against a parameter: one result of :func:`amble.mfpt` or
+    :func:`amble.markov_mfpt` per value, drawn with its ``ci_low``–``ci_high`` as an error bar
+    (a confidence interval for Monte Carlo, the spread of the two finest meshes for the chain).
+    A walker that never fell (MFPT ∞) is left out."""
+    plt = _plt()
+    x, y, lo, hi = [], [], [], []
+    for v, r in zip(values, results):
+        if np.isfinite(r.mfpt):
+            x.append(float(v))
+            y.append(r.mfpt)
+            lo.append(r.mfpt - r.ci_low)
+            hi.append((r.ci_high - r.mfpt) if np.isfinite(r.ci_high) else 0.0)
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    ax.errorbar(x, y, yerr=[lo, hi], fmt="o-", ms=4, capsize=3)
+    ax.set_yscale("log")
+    ax.set_xlabel(_label(label))
+    ax.set_ylabel("mean first-passage time (steps)")
+    ax.set_title(title or "Mean first-passage time to a fall")
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+__all__ = ["plot_metastable", "plot_mfpt_against"]
