@@ -22,10 +22,11 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
     m.add_argument("--terrain", action="append", required=True, metavar="NAME~normal(MEAN,SD)",
                    help="a parameter drawn for every step: NAME~normal(MEAN,SD) or NAME~uniform(LOW,HIGH) "
                         "(repeatable); e.g. slope~normal(0.08,0.02): each step on its own ramp")
-    m.add_argument("--runs", type=int, default=1000, help="walkers (default 1000)")
-    m.add_argument("--max-steps", type=int, default=1000, help="steps a walker walks at most (default 1000)")
-    m.add_argument("--seed", type=int, default=0, help="seed of the terrain's draws (default 0)")
-    m.add_argument("--threads", type=int, default=1, help="threads the walkers share (default 1)")
+    m.add_argument("--runs", type=int, default=1000, help="montecarlo: walkers (default 1000)")
+    m.add_argument("--max-steps", type=int, default=1000,
+                   help="montecarlo: steps a walker walks at most (default 1000)")
+    m.add_argument("--seed", type=int, default=0, help="montecarlo: seed of the terrain's draws (default 0)")
+    m.add_argument("--threads", type=int, default=1, help="threads the walks share (default 1)")
     m.add_argument("--method", choices=("montecarlo", "markov"), default="montecarlo",
                    help="estimator: montecarlo (walkers, a confidence interval) or markov (a chain on a mesh of "
                         "the section, the value at each refinement level; default montecarlo)")
