@@ -53,11 +53,14 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("hybrid_invariance_error", "invariant_parameters", "restricted_map"), ".analysis.hzd"),
     "optimize_gait": ".analysis.gait_optimisation",
     **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
+    **dict.fromkeys(("MarkovPassage", "markov_mfpt"), ".analysis.markov"),
+    **dict.fromkeys(("GaitSensitivity", "gait_sensitivity"), ".analysis.robustness"),
     "gait_gradients": ".analysis.gait_gradients",
     "check_gait": ".analysis.gait_check",
     "simulate": ".simulation.simulate",
     **dict.fromkeys(("Event", "Trajectory"), ".simulation.trajectory"),
     **dict.fromkeys(("animate", "plot_limit_cycle", "plot_trajectory"), ".viz"),
+    **dict.fromkeys(("plot_metastable", "plot_mfpt_against"), ".viz.metastable"),
 }
 
 __all__ = sorted(_WHERE, key=lambda n: (not n.isupper(), n))

@@ -30,6 +30,8 @@ from .gaits import add_parser as add_gaits_parser
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
 from .output import gait_check_lines, write_output
+from .robustness import EXAMPLE as ROBUSTNESS_EXAMPLE
+from .robustness import add_parser as add_robustness_parser
 
 #: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
 MAX_PERIOD = 1000
@@ -237,6 +239,7 @@ EXAMPLES = {
     "gaits": GAITS_EXAMPLE,
     "doublings": DOUBLINGS_EXAMPLE,
     "mfpt": MFPT_EXAMPLE,
+    "robustness": ROBUSTNESS_EXAMPLE,
     "cache": "amble cache clear --older-than 30 --dry-run",
 }
 
@@ -380,6 +383,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     add_gaits_parser(add, model_arg)
     add_doublings_parser(add, model_arg)
     add_mfpt_parser(add, model_arg)
+    add_robustness_parser(add, model_arg)
     add_cache_parser(add)
     return p
 
