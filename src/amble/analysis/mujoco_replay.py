@@ -1,0 +1,359 @@
+"""A planar biped and its controlled gait in MuJoCo: the robot as MJCF, soft ground contact, amble's
+control law in MuJoCo's loop, and the drift between the two runs per step.
+
+amble's walker is pinned at its stance foot and its footfall is an instantaneous plastic impact;
+MuJoCo's robot is free in the sagittal plane (a *planar root*: ``rootx`` slides along x,
+``rootz`` along z, the hinge ``torso`` turns about +y) and stands on the ground through a soft,
+penetrable contact with friction. Replaying the same control law in both tells how much of a gait
+survives soft contacts before it is tried on hardware.
+
+The layout exported is RABBIT's (:mod:`amble.models.rabbit`): a torso and two legs of femur and
+tibia with point feet, coordinates ``torso stance_hip swing_hip stance_knee swing_knee`` and
+parameters ``mT mf mt lf lt pT pf pt IT If It g`` (their values, defaults or ``params``, set the
+MJCF's masses, centres of mass and inertias). A robot file (URDF or MJCF) needs no export: MuJoCo
+loads it directly.
+
+Conventions, as amble's MJCF import (:mod:`amble.modelling.mjcf`) reads a file: x forward, z up,
+y lateral; a hinge about +y by ``φ`` turns the z axis to ``(sin φ, 0, cos φ)``, which is amble's
+``R(φ)``, so an absolute link angle of the model is the link's pitch in MuJoCo and a joint angle
+(a difference of absolute angles) is MuJoCo's hinge angle of the child body. The MuJoCo legs are
+``a`` and ``b``; the stance leg is ``a`` at the start and the legs swap roles at every footfall,
+as amble's relabelling swaps the coordinates. Each link's inertia is its scalar planar inertia
+about the ``y`` axis through its centre of mass (``diaginertia`` ``I I I``; the other two
+components do not act in the plane).
+
+The control law is amble's compiled one: at every MuJoCo step the state is read in amble's
+coordinates (stance leg first) and the generalized force ``Γ + B u`` of the compiled model is
+applied through one motor per actuated joint (``ctrl`` = ``u``, clipped to the declared limits).
+A footfall in MuJoCo is the swing foot touching the ground ahead of the stance foot.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError, ParameterError
+
+#: amble's coordinates of the exported layout, in order, and the MuJoCo joint each one is while leg
+#: ``a`` stands (leg ``b`` standing swaps ``a`` and ``b``)
+COORDINATES = ("torso", "stance_hip", "swing_hip", "stance_knee", "swing_knee")
+_JOINT_OF = {"torso": "torso", "stance_hip": "hip_{s}", "swing_hip": "hip_{w}", "stance_knee": "knee_{s}",
+             "swing_knee": "knee_{w}"}
+#: MuJoCo's generalized coordinates of the export, in order
+MUJOCO_JOINTS = ("rootx", "rootz", "torso", "hip_a", "knee_a", "hip_b", "knee_b")
+_PARAMETERS = ("mT", "mf", "mt", "lf", "lt", "pT", "pf", "pt", "IT", "If", "It", "g")
+#: the torso's drawn length (m; RABBIT's head point)
+_TORSO_LENGTH = 0.625
+
+
+def _mujoco() -> Any:
+    try:
+        import mujoco
+    except ImportError as e:  # pragma: no cover - a declared dependency of the extra
+        raise ModelError("the MuJoCo export needs the 'mujoco' package: pip install 'amble[mjcf]'") from e
+    return mujoco
+
+
+def _values(system: Any, params: Mapping[str, float] | None) -> dict[str, float]:
+    """The system's parameter values with ``params`` applied; refuses a model of another layout."""
+    declared = dict(system.parameters)
+    mode = system.mode_names[0]
+    names = system.state_names(mode)
+    missing = [p for p in _PARAMETERS if p not in declared]
+    if tuple(names[: len(COORDINATES)]) != COORDINATES or len(names) != 2 * len(COORDINATES) or missing:
+        raise ModelError(f"model {system.name!r}: the MuJoCo export knows the planar five-link biped with "
+                         f"coordinates {' '.join(COORDINATES)} and parameters {' '.join(_PARAMETERS)} "
+                         "(RABBIT's layout); a robot file loads in MuJoCo directly")
+    unknown = sorted(set(params or {}) - set(declared))
+    if unknown:
+        raise ParameterError(f"unknown parameter {unknown[0]!r} of model {system.name!r}")
+    declared.update({k: float(v) for k, v in (params or {}).items()})
+    if declared.get("slope", 0.0) != 0.0:
+        raise ParameterError("the MuJoCo export stands the robot on level ground: slope must be 0")
+    return declared
+
+
+def planar_biped_mjcf(system: Any, params: Mapping[str, float] | None = None, *, foot_radius: float = 0.005,
+                      friction: float = 1.0, timestep: float = 5e-4,
+                      limits: Mapping[str, float | None] | None = None) -> str:
+    """The MJCF text of a planar five-link biped (RABBIT's layout) with a ground plane.
+
+    ``foot_radius`` (m): each point foot is a sphere of this radius centred on the foot, the floor
+    lies ``foot_radius`` below ``z = 0`` so that a foot touches it at amble's height 0;
+    ``friction``: the sliding friction coefficient of foot and floor; ``timestep`` (s): MuJoCo's
+    step; ``limits``: MuJoCo joint name → torque limit (N·m; ``ctrlrange``), None for no limit.
+    Only the feet collide, only with the floor.
+    """
+    v = _values(system, params)
+    if not (foot_radius > 0 and friction > 0 and timestep > 0):
+        raise ParameterError(f"foot_radius, friction and timestep must be positive, got {foot_radius}, "
+                             f"{friction}, {timestep}")
+
+    def inertial(z: float, mass: float, inertia: float) -> str:
+        return f'<inertial pos="0 0 {z!r}" mass="{mass!r}" diaginertia="{inertia!r} {inertia!r} {inertia!r}"/>'
+
+    def leg(s: str) -> str:
+        lf, lt = v["lf"], v["lt"]
+        return f"""
+      <body name="femur_{s}">
+        <joint name="hip_{s}" type="hinge" axis="0 1 0"/>
+        {inertial(-v["pf"], v["mf"], v["If"])}
+        <geom type="capsule" fromto="0 0 0 0 0 {-lf!r}" size="0.02" contype="0" conaffinity="0" group="1"/>
+        <body name="tibia_{s}" pos="0 0 {-lf!r}">
+          <joint name="knee_{s}" type="hinge" axis="0 1 0"/>
+          {inertial(-v["pt"], v["mt"], v["It"])}
+          <geom type="capsule" fromto="0 0 0 0 0 {-lt!r}" size="0.015" contype="0" conaffinity="0" group="1"/>
+          <geom name="foot_{s}" type="sphere" pos="0 0 {-lt!r}" size="{foot_radius!r}" contype="1"
+                conaffinity="0" condim="3" friction="{friction!r} 0.005 0.0001"/>
+          <site name="foot_{s}" pos="0 0 {-lt!r}"/>
+        </body>
+      </body>"""
+
+    motors = []
+    for joint in MUJOCO_JOINTS[3:]:
+        lim = (limits or {}).get(joint)
+        rng = f' ctrlrange="{-lim!r} {lim!r}" ctrllimited="true"' if lim is not None else ' ctrllimited="false"'
+        motors.append(f'    <motor name="{joint}" joint="{joint}" gear="1"{rng}/>')
+    return f"""<mujoco model="{system.name}">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <option timestep="{timestep!r}" gravity="0 0 {-v["g"]!r}" integrator="implicitfast"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1" pos="0 0 {-foot_radius!r}" contype="0" conaffinity="1"
+          friction="{friction!r} 0.005 0.0001"/>
+    <body name="torso">
+      <joint name="rootx" type="slide" axis="1 0 0"/>
+      <joint name="rootz" type="slide" axis="0 0 1"/>
+      <joint name="torso" type="hinge" axis="0 1 0"/>
+      {inertial(v["pT"], v["mT"], v["IT"])}
+      <geom type="capsule" fromto="0 0 0 0 0 {_TORSO_LENGTH!r}" size="0.03" contype="0" conaffinity="0"
+            group="1"/>
+      <site name="hip"/>{leg("a")}{leg("b")}
+    </body>
+  </worldbody>
+  <actuator>
+{chr(10).join(motors)}
+  </actuator>
+</mujoco>
+"""
+
+
+def _joint_order(stance: int) -> list[int]:
+    """Index into MuJoCo's ``qpos`` of each amble coordinate while leg ``stance`` (0: a, 1: b) stands."""
+    s, w = ("a", "b") if stance == 0 else ("b", "a")
+    return [MUJOCO_JOINTS.index(_JOINT_OF[c].format(s=s, w=w)) for c in COORDINATES]
+
+
+def mujoco_state(x: Sequence[float], values: Mapping[str, float], stance: int = 0,
+                 foot: Sequence[float] = (0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """MuJoCo's ``(qpos, qvel)`` of amble's state ``x`` (``COORDINATES`` then their rates) with the
+    stance foot of leg ``stance`` at ``foot = (x, z)`` (m) and at rest: the hip is where the stance
+    leg puts it, ``hip = foot + lt R(θ_tibia) + lf R(θ_femur)``."""
+    x = np.asarray(x, dtype=float)
+    q, qd = x[:5], x[5:]
+    f1, t1 = q[0] + q[1], q[0] + q[1] + q[3]
+    f1d, t1d = qd[0] + qd[1], qd[0] + qd[1] + qd[3]
+    lf, lt = values["lf"], values["lt"]
+    hip = np.array(foot, dtype=float) + lt * np.array([np.sin(t1), np.cos(t1)]) + lf * np.array([np.sin(f1), np.cos(f1)])
+    hip_d = lt * t1d * np.array([np.cos(t1), -np.sin(t1)]) + lf * f1d * np.array([np.cos(f1), -np.sin(f1)])
+    qpos, qvel = np.zeros(len(MUJOCO_JOINTS)), np.zeros(len(MUJOCO_JOINTS))
+    qpos[:2], qvel[:2] = hip, hip_d
+    idx = _joint_order(stance)
+    qpos[idx], qvel[idx] = q, qd
+    return qpos, qvel
+
+
+def amble_state(qpos: np.ndarray, qvel: np.ndarray, stance: int) -> np.ndarray:
+    """amble's state (``COORDINATES`` then their rates) of MuJoCo's ``(qpos, qvel)`` with leg
+    ``stance`` standing."""
+    idx = _joint_order(stance)
+    return np.concatenate([qpos[idx], qvel[idx]])
+
+
+@dataclass
+class StepDrift:
+    """One step of both runs: MuJoCo's and amble's step time (s) and step length (m, foot to
+    foot at the footfall), the RMS difference of the five angles over the step (rad, at equal
+    time since the step began, over the shorter of the two steps), and MuJoCo's stance foot:
+    how far it slid along the ground (m) and how deep it sank at most (m)."""
+
+    step: int
+    step_time: float
+    amble_step_time: float
+    step_length: float
+    amble_step_length: float
+    angle_rms: float
+    stance_slip: float
+    penetration: float
+
+    def to_json(self) -> dict[str, Any]:
+        return {k: (float(v) if k != "step" else int(v)) for k, v in self.__dict__.items()}
+
+
+@dataclass
+class MujocoReplay:
+    """The outcome of :func:`replay_in_mujoco`: ``status`` ``completed`` (all steps walked) or
+    ``fell`` (hip below half its standing height, or no footfall in three amble step times),
+    the steps walked, their drift from amble's run, the largest input (N·m) and the MJCF."""
+
+    status: str
+    steps: int
+    drift: list[StepDrift]
+    max_input: float
+    time: float
+    mjcf: str = field(repr=False)
+
+    def summary(self) -> dict[str, float]:
+        """The largest drift over the steps: ``|Δ step time|`` (s), ``|Δ step length|`` (m), angle
+        RMS (rad), stance-foot slip and penetration (m)."""
+        d = self.drift
+        if not d:
+            return {}
+        return {"max_step_time_error": max(abs(s.step_time - s.amble_step_time) for s in d),
+                "max_step_length_error": max(abs(s.step_length - s.amble_step_length) for s in d),
+                "max_angle_rms": max(s.angle_rms for s in d),
+                "max_stance_slip": max(s.stance_slip for s in d),
+                "max_penetration": max(s.penetration for s in d)}
+
+    def to_json(self) -> dict[str, Any]:
+        return {"status": self.status, "steps": self.steps, "time": self.time, "max_input": self.max_input,
+                "drift": self.summary(), "per_step": [s.to_json() for s in self.drift]}
+
+
+def _reference(system: Any, x0: np.ndarray, values: Mapping[str, float], steps: int, dt: float):
+    """amble's own run: per step its start time, step time, step length and sampled angles."""
+    from ..simulation.simulate import simulate
+
+    tr = simulate(system, x0, params=dict(values), steps=steps, sample_dt=dt)
+    events = tr.step_events
+    starts = [0.0] + [e.t for e in events]
+    names = tr.kernels.meta["points"]
+    pre = np.array([e.x_pre for e in events]) if events else np.zeros((0, len(x0)))
+    mode_ix = np.zeros(len(events), dtype=np.int64)
+    pos, _ = tr.kernels.kinematics_rows(np.array([e.t for e in events]), mode_ix, pre, tr.params)
+    lengths = pos[:, names.index("swing_foot"), 0] - pos[:, names.index("stance_foot"), 0]
+    return tr, starts, lengths
+
+
+def _segment(tr: Any, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray]:
+    """amble's samples of one step, from its post-impact row at ``t0`` to its pre-impact row at ``t1``."""
+    i0 = int(np.searchsorted(tr.t, t0, side="right")) - 1
+    i1 = int(np.searchsorted(tr.t, t1, side="left"))
+    return tr.t[i0 : i1 + 1] - t0, tr.x[i0 : i1 + 1, :5]
+
+
+class _Walk:
+    """MuJoCo's run, one step of MuJoCo at a time, with the footfall bookkeeping."""
+
+    def __init__(self, system: Any, values: Mapping[str, float], xml: str, x0: np.ndarray) -> None:
+        from ..backend.kernels import compiled
+        from ..simulation.simulate import parameter_vector
+
+        mj = self.mj = _mujoco()
+        self.m = mj.MjModel.from_xml_string(xml)
+        self.d = mj.MjData(self.m)
+        self.k = compiled(system)
+        self.p = parameter_vector(self.k, dict(values), system)
+        self.mode = system.mode_names[0]
+        self.stance = 0
+        qpos, qvel = mujoco_state(x0, values, 0)
+        self.d.qpos[:], self.d.qvel[:] = qpos, qvel
+        mj.mj_forward(self.m, self.d)
+        self.feet = [mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_GEOM, f"foot_{s}") for s in "ab"]
+        self.sites = [mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_SITE, f"foot_{s}") for s in "ab"]
+        self.hip = mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_SITE, "hip")
+        # the motor of each amble coordinate, per stance leg (the torso has none)
+        acts = [mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_ACTUATOR, j) for j in MUJOCO_JOINTS[3:]]
+        self.motor = [[acts[MUJOCO_JOINTS[3:].index(MUJOCO_JOINTS[i])] for i in _joint_order(s)[1:]] for s in (0, 1)]
+
+    def state(self) -> np.ndarray:
+        return amble_state(self.d.qpos, self.d.qvel, self.stance)
+
+    def control(self) -> np.ndarray:
+        """amble's law at the current state: ``Γ + B u`` on the joints (N·m)."""
+        _, _, gamma = self.k.dynamics(self.mode, float(self.d.time), self.state(), self.p)
+        u = gamma[1:]
+        self.d.ctrl[self.motor[self.stance]] = u
+        return u
+
+    def touchdown(self) -> bool:
+        """The swing foot touches the floor ahead of the stance foot."""
+        swing = self.feet[1 - self.stance]
+        touching = any(swing in (c.geom1, c.geom2) for c in self.d.contact[: self.d.ncon])
+        ahead = self.d.site_xpos[self.sites[1 - self.stance], 0] > self.d.site_xpos[self.sites[self.stance], 0]
+        return bool(touching and ahead)
+
+    def foot(self, which: int) -> np.ndarray:
+        return self.d.site_xpos[self.sites[which]][[0, 2]].copy()
+
+
+def replay_in_mujoco(system: Any, steps: int = 10, *, params: Mapping[str, float] | None = None,
+                     x0: Sequence[float] | None = None, timestep: float = 5e-4, foot_radius: float = 0.005,
+                     friction: float = 1.0) -> MujocoReplay:
+    """Walk ``steps`` footfalls of a planar biped (RABBIT's layout) in MuJoCo under amble's control
+    law, from amble's post-impact state ``x0`` (default: the system's start, the gait's fixed point
+    for ``rabbit``) with the stance foot at the origin, and compare each step with amble's run
+    from the same state (:class:`StepDrift`). MuJoCo's contact is soft (its default ``solref``,
+    ``solimp``), its integrator ``implicitfast`` with step ``timestep`` (s); see
+    :func:`planar_biped_mjcf` for ``foot_radius`` and ``friction``.
+    """
+    if not 1 <= int(steps) <= 10000:
+        raise ParameterError(f"steps must be at least 1 and at most 10000, got {steps}")
+    values = _values(system, params)
+    if x0 is None and system.mode_names[0] not in system.default_start:
+        raise ParameterError(f"model {system.name!r} declares no start: give x0")
+    x0 = np.asarray(system.default_start[system.mode_names[0]] if x0 is None else x0, dtype=float)
+    if x0.shape != (2 * len(COORDINATES),):
+        raise ParameterError(f"x0 must have {2 * len(COORDINATES)} values (state_names order), got {x0.size}")
+    symbolic = system.symbolic()
+    joints_of = dict(zip(COORDINATES, MUJOCO_JOINTS[2:3] + ("hip_a", "hip_b", "knee_a", "knee_b")))
+    limits: dict[str, float | None] = {}
+    for model in symbolic.modes.values():
+        for a in getattr(model, "actuators", []):
+            coord = str(a.on)
+            if coord not in COORDINATES[1:]:
+                raise ModelError(f"model {system.name!r}: input {a.symbol} must drive one joint coordinate")
+            limits[joints_of[coord]] = a.limit
+    for s, w in (("a", "b"), ("b", "a")):  # both legs get the limit of the role they take
+        limits[f"hip_{s}"] = limits.get(f"hip_{s}") or limits.get(f"hip_{w}")
+        limits[f"knee_{s}"] = limits.get(f"knee_{s}") or limits.get(f"knee_{w}")
+    xml = planar_biped_mjcf(system, values, foot_radius=foot_radius, friction=friction, timestep=timestep,
+                            limits=limits)
+    ref, starts, lengths = _reference(system, x0, values, steps, timestep)
+    amble_times = np.diff(starts)
+    walk = _Walk(system, values, xml, x0)
+    hip_height = float(walk.d.site_xpos[walk.hip, 2])
+    patience = 3.0 * (float(np.mean(amble_times)) if len(amble_times) else 1.0)
+    drift: list[StepDrift] = []
+    t_step, samples_t, samples_q = 0.0, [], []
+    stance_start, deepest, max_u, status = walk.foot(0), 0.0, 0.0, "completed"
+    while len(drift) < steps:
+        max_u = max(max_u, float(np.max(np.abs(walk.control()))))
+        walk.mj.mj_step(walk.m, walk.d)
+        t = float(walk.d.time)
+        samples_t.append(t - t_step)
+        samples_q.append(walk.state()[:5])
+        deepest = max(deepest, -float(walk.foot(walk.stance)[1]))
+        if walk.d.site_xpos[walk.hip, 2] < 0.5 * hip_height or t - t_step > patience:
+            status = "fell"
+            break
+        if not walk.touchdown() or t - t_step < 0.2 * patience / 3.0:
+            continue
+        k = len(drift)
+        swing, stance = walk.foot(1 - walk.stance), walk.foot(walk.stance)
+        rms = float("nan")
+        if k < len(amble_times):
+            ta, qa = _segment(ref, starts[k], starts[k + 1])
+            tm = np.asarray(samples_t)
+            keep = tm <= min(ta[-1], tm[-1])
+            qi = np.column_stack([np.interp(tm[keep], ta, qa[:, j]) for j in range(5)])
+            rms = float(np.sqrt(np.mean((np.asarray(samples_q)[keep] - qi) ** 2)))
+        drift.append(StepDrift(k, t - t_step, float(amble_times[k]) if k < len(amble_times) else float("nan"),
+                               float(swing[0] - stance[0]), float(lengths[k]) if k < len(lengths) else float("nan"),
+                               rms, float(abs(stance[0] - stance_start[0])), deepest))
+        walk.stance = 1 - walk.stance
+        t_step, samples_t, samples_q, stance_start, deepest = t, [], [], swing, 0.0
+    return MujocoReplay(status, len(drift), drift, max_u, float(walk.d.time), xml)
