@@ -46,6 +46,8 @@ _JOINT_OF = {"torso": "torso", "stance_hip": "hip_{s}", "swing_hip": "hip_{w}", 
 #: MuJoCo's generalized coordinates of the export, in order
 MUJOCO_JOINTS = ("rootx", "rootz", "torso", "hip_a", "knee_a", "hip_b", "knee_b")
 _PARAMETERS = ("mT", "mf", "mt", "lf", "lt", "pT", "pf", "pt", "IT", "If", "It", "g")
+#: MuJoCo's step (s) and the contact's time constant (s) of a replay: a stiff contact, integrated finely
+TIMESTEP, CONTACT_TIME = 2e-4, 5e-3
 #: the torso's drawn length (m; RABBIT's head point)
 _TORSO_LENGTH = 0.625
 
@@ -78,20 +80,23 @@ def _values(system: Any, params: Mapping[str, float] | None) -> dict[str, float]
 
 
 def planar_biped_mjcf(system: Any, params: Mapping[str, float] | None = None, *, foot_radius: float = 0.005,
-                      friction: float = 1.0, timestep: float = 5e-4,
+                      friction: float = 1.0, timestep: float = TIMESTEP, contact_time: float = CONTACT_TIME,
                       limits: Mapping[str, float | None] | None = None) -> str:
     """The MJCF text of a planar five-link biped (RABBIT's layout) with a ground plane.
 
     ``foot_radius`` (m): each point foot is a sphere of this radius centred on the foot, the floor
     lies ``foot_radius`` below ``z = 0`` so that a foot touches it at amble's height 0;
     ``friction``: the sliding friction coefficient of foot and floor; ``timestep`` (s): MuJoCo's
-    step; ``limits``: MuJoCo joint name → torque limit (N·m; ``ctrlrange``), None for no limit.
+    step; ``contact_time`` (s): the time constant of the contact's spring-damper (MuJoCo's
+    ``solref = "contact_time 1"``, critically damped; at least two ``timestep``), smaller is
+    stiffer and closer to amble's rigid ground; ``limits``: MuJoCo joint name → torque limit
+    (N·m; ``ctrlrange``), None for no limit.
     Only the feet collide, only with the floor.
     """
     v = _values(system, params)
-    if not (foot_radius > 0 and friction > 0 and timestep > 0):
-        raise ParameterError(f"foot_radius, friction and timestep must be positive, got {foot_radius}, "
-                             f"{friction}, {timestep}")
+    if not (foot_radius > 0 and friction > 0 and timestep > 0 and contact_time >= 2 * timestep):
+        raise ParameterError(f"foot_radius, friction and timestep must be positive and contact_time at least two "
+                             f"timesteps, got {foot_radius}, {friction}, {timestep}, {contact_time}")
 
     def inertial(z: float, mass: float, inertia: float) -> str:
         return f'<inertial pos="0 0 {z!r}" mass="{mass!r}" diaginertia="{inertia!r} {inertia!r} {inertia!r}"/>'
@@ -108,7 +113,7 @@ def planar_biped_mjcf(system: Any, params: Mapping[str, float] | None = None, *,
           {inertial(-v["pt"], v["mt"], v["It"])}
           <geom type="capsule" fromto="0 0 0 0 0 {-lt!r}" size="0.015" contype="0" conaffinity="0" group="1"/>
           <geom name="foot_{s}" type="sphere" pos="0 0 {-lt!r}" size="{foot_radius!r}" contype="1"
-                conaffinity="0" condim="3" friction="{friction!r} 0.005 0.0001"/>
+                conaffinity="0" condim="3" friction="{friction!r} 0.005 0.0001" solref="{contact_time!r} 1"/>
           <site name="foot_{s}" pos="0 0 {-lt!r}"/>
         </body>
       </body>"""
@@ -123,7 +128,7 @@ def planar_biped_mjcf(system: Any, params: Mapping[str, float] | None = None, *,
   <option timestep="{timestep!r}" gravity="0 0 {-v["g"]!r}" integrator="implicitfast"/>
   <worldbody>
     <geom name="floor" type="plane" size="0 0 1" pos="0 0 {-foot_radius!r}" contype="0" conaffinity="1"
-          friction="{friction!r} 0.005 0.0001"/>
+          friction="{friction!r} 0.005 0.0001" solref="{contact_time!r} 1"/>
     <body name="torso">
       <joint name="rootx" type="slide" axis="1 0 0"/>
       <joint name="rootz" type="slide" axis="0 0 1"/>
@@ -141,10 +146,17 @@ def planar_biped_mjcf(system: Any, params: Mapping[str, float] | None = None, *,
 """
 
 
-def _joint_order(stance: int) -> list[int]:
-    """Index into MuJoCo's ``qpos`` of each amble coordinate while leg ``stance`` (0: a, 1: b) stands."""
+def _order(stance: int) -> list[int]:
     s, w = ("a", "b") if stance == 0 else ("b", "a")
     return [MUJOCO_JOINTS.index(_JOINT_OF[c].format(s=s, w=w)) for c in COORDINATES]
+
+
+_ORDERS = (_order(0), _order(1))
+
+
+def _joint_order(stance: int) -> list[int]:
+    """Index into MuJoCo's ``qpos`` of each amble coordinate while leg ``stance`` (0: a, 1: b) stands."""
+    return _ORDERS[stance]
 
 
 def mujoco_state(x: Sequence[float], values: Mapping[str, float], stance: int = 0,
@@ -157,8 +169,14 @@ def mujoco_state(x: Sequence[float], values: Mapping[str, float], stance: int = 
     f1, t1 = q[0] + q[1], q[0] + q[1] + q[3]
     f1d, t1d = qd[0] + qd[1], qd[0] + qd[1] + qd[3]
     lf, lt = values["lf"], values["lt"]
-    hip = np.array(foot, dtype=float) + lt * np.array([np.sin(t1), np.cos(t1)]) + lf * np.array([np.sin(f1), np.cos(f1)])
-    hip_d = lt * t1d * np.array([np.cos(t1), -np.sin(t1)]) + lf * f1d * np.array([np.cos(f1), -np.sin(f1)])
+    def r(a: float) -> np.ndarray:  # amble's R(θ) in the (x, z) plane, and its derivative
+        return np.array([np.sin(a), np.cos(a)])
+
+    def dr(a: float) -> np.ndarray:
+        return np.array([np.cos(a), -np.sin(a)])
+
+    hip = np.asarray(foot, dtype=float) + lt * r(t1) + lf * r(f1)
+    hip_d = lt * t1d * dr(t1) + lf * f1d * dr(f1)
     qpos, qvel = np.zeros(len(MUJOCO_JOINTS)), np.zeros(len(MUJOCO_JOINTS))
     qpos[:2], qvel[:2] = hip, hip_d
     idx = _joint_order(stance)
@@ -197,12 +215,16 @@ class StepDrift:
 class MujocoReplay:
     """The outcome of :func:`replay_in_mujoco`: ``status`` ``completed`` (all steps walked) or
     ``fell`` (hip below half its standing height, or no footfall in three amble step times),
-    the steps walked, their drift from amble's run, the largest input (N·m) and the MJCF."""
+    the steps walked, their drift from amble's run, the largest input the law asked for (N·m;
+    MuJoCo clips it to the declared limits), how long any input was clipped in all (s; the law
+    meets each soft footfall with the velocities before the impact, for a few ms), the time
+    walked (s) and the MJCF."""
 
     status: str
     steps: int
     drift: list[StepDrift]
     max_input: float
+    saturated_time: float
     time: float
     mjcf: str = field(repr=False)
 
@@ -220,29 +242,48 @@ class MujocoReplay:
 
     def to_json(self) -> dict[str, Any]:
         return {"status": self.status, "steps": self.steps, "time": self.time, "max_input": self.max_input,
-                "drift": self.summary(), "per_step": [s.to_json() for s in self.drift]}
+                "saturated_time": self.saturated_time, "drift": self.summary(),
+                "per_step": [s.to_json() for s in self.drift]}
 
 
-def _reference(system: Any, x0: np.ndarray, values: Mapping[str, float], steps: int, dt: float):
-    """amble's own run: per step its start time, step time, step length and sampled angles."""
-    from ..simulation.simulate import simulate
+class _Reference:
+    """amble's own run from the same state: per step its start time, step time, step length
+    (swing foot less stance foot at the footfall, m) and its sampled angles."""
 
-    tr = simulate(system, x0, params=dict(values), steps=steps, sample_dt=dt)
-    events = tr.step_events
-    starts = [0.0] + [e.t for e in events]
-    names = tr.kernels.meta["points"]
-    pre = np.array([e.x_pre for e in events]) if events else np.zeros((0, len(x0)))
-    mode_ix = np.zeros(len(events), dtype=np.int64)
-    pos, _ = tr.kernels.kinematics_rows(np.array([e.t for e in events]), mode_ix, pre, tr.params)
-    lengths = pos[:, names.index("swing_foot"), 0] - pos[:, names.index("stance_foot"), 0]
-    return tr, starts, lengths
+    def __init__(self, system: Any, x0: np.ndarray, values: Mapping[str, float], steps: int, dt: float) -> None:
+        from ..simulation.simulate import simulate
 
+        tr = self.tr = simulate(system, x0, params=dict(values), steps=steps, sample_dt=dt)
+        events = tr.step_events
+        self.starts = np.array([0.0] + [e.t for e in events])
+        self.times = np.diff(self.starts)
+        names = tr.kernels.meta["points"]
+        pre = np.array([e.x_pre for e in events]).reshape(len(events), len(x0))
+        pos, _ = tr.kernels.kinematics_rows(self.starts[1:], np.zeros(len(events), dtype=np.int64), pre, tr.params)
+        self.lengths = pos[:, names.index("swing_foot"), 0] - pos[:, names.index("stance_foot"), 0]
 
-def _segment(tr: Any, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray]:
-    """amble's samples of one step, from its post-impact row at ``t0`` to its pre-impact row at ``t1``."""
-    i0 = int(np.searchsorted(tr.t, t0, side="right")) - 1
-    i1 = int(np.searchsorted(tr.t, t1, side="left"))
-    return tr.t[i0 : i1 + 1] - t0, tr.x[i0 : i1 + 1, :5]
+    def mean_step_time(self) -> float:
+        return float(np.mean(self.times)) if len(self.times) else 1.0
+
+    def step(self, k: int) -> tuple[float, float]:
+        """Step ``k``'s time (s) and length (m); NaN after amble's run ended."""
+        if k >= len(self.times):
+            return float("nan"), float("nan")
+        return float(self.times[k]), float(self.lengths[k])
+
+    def angle_rms(self, k: int, t: np.ndarray, q: np.ndarray) -> float:
+        """RMS difference (rad) of angles ``q`` sampled at ``t`` since step ``k`` began from amble's
+        at the same times, over the shorter of the two steps."""
+        if k >= len(self.times):
+            return float("nan")
+        tr, t0, t1 = self.tr, self.starts[k], self.starts[k + 1]
+        # from the post-impact row at t0 to the pre-impact row at t1 (events give a row on both sides)
+        i0 = int(np.searchsorted(tr.t, t0, side="right")) - 1
+        i1 = int(np.searchsorted(tr.t, t1, side="left"))
+        ta, qa = tr.t[i0 : i1 + 1] - t0, tr.x[i0 : i1 + 1, : len(COORDINATES)]
+        keep = t <= min(ta[-1], t[-1])
+        qi = np.column_stack([np.interp(t[keep], ta, qa[:, j]) for j in range(qa.shape[1])])
+        return float(np.sqrt(np.mean((q[keep] - qi) ** 2)))
 
 
 class _Walk:
@@ -272,33 +313,50 @@ class _Walk:
     def state(self) -> np.ndarray:
         return amble_state(self.d.qpos, self.d.qvel, self.stance)
 
-    def control(self) -> np.ndarray:
-        """amble's law at the current state: ``Γ + B u`` on the joints (N·m)."""
-        _, _, gamma = self.k.dynamics(self.mode, float(self.d.time), self.state(), self.p)
+    def control(self, x: np.ndarray) -> np.ndarray:
+        """amble's law at amble's state ``x``: ``Γ + B u`` on the joints (N·m)."""
+        _, _, gamma = self.k.dynamics(self.mode, float(self.d.time), x, self.p)
         u = gamma[1:]
         self.d.ctrl[self.motor[self.stance]] = u
         return u
 
     def touchdown(self) -> bool:
         """The swing foot touches the floor ahead of the stance foot."""
-        swing = self.feet[1 - self.stance]
-        touching = any(swing in (c.geom1, c.geom2) for c in self.d.contact[: self.d.ncon])
-        ahead = self.d.site_xpos[self.sites[1 - self.stance], 0] > self.d.site_xpos[self.sites[self.stance], 0]
-        return bool(touching and ahead)
+        swing, xpos = self.feet[1 - self.stance], self.d.site_xpos
+        if xpos[self.sites[1 - self.stance], 0] <= xpos[self.sites[self.stance], 0] or not self.d.ncon:
+            return False
+        return bool(np.any(self.d.contact.geom[: self.d.ncon] == swing))
 
     def foot(self, which: int) -> np.ndarray:
         return self.d.site_xpos[self.sites[which]][[0, 2]].copy()
 
 
+def _limits(system: Any) -> dict[str, float | None]:
+    """MuJoCo joint → the torque limit of the input on it (N·m), both legs alike."""
+    joints_of = dict(zip(COORDINATES, ("torso", "hip_a", "hip_b", "knee_a", "knee_b")))
+    limits: dict[str, float | None] = {}
+    for model in system.symbolic().modes.values():
+        for a in getattr(model, "actuators", []):
+            coord = str(a.on)
+            if coord not in COORDINATES[1:]:
+                raise ModelError(f"model {system.name!r}: input {a.symbol} must drive one joint coordinate")
+            limits[joints_of[coord]] = a.limit
+    for s, w in (("a", "b"), ("b", "a")):  # a leg's input has the limit of either role's
+        for joint in ("hip", "knee"):
+            limits[f"{joint}_{s}"] = limits.get(f"{joint}_{s}") or limits.get(f"{joint}_{w}")
+    return limits
+
+
 def replay_in_mujoco(system: Any, steps: int = 10, *, params: Mapping[str, float] | None = None,
-                     x0: Sequence[float] | None = None, timestep: float = 5e-4, foot_radius: float = 0.005,
-                     friction: float = 1.0) -> MujocoReplay:
+                     x0: Sequence[float] | None = None, timestep: float = TIMESTEP, contact_time: float = CONTACT_TIME,
+                     foot_radius: float = 0.005, friction: float = 1.0) -> MujocoReplay:
     """Walk ``steps`` footfalls of a planar biped (RABBIT's layout) in MuJoCo under amble's control
     law, from amble's post-impact state ``x0`` (default: the system's start, the gait's fixed point
     for ``rabbit``) with the stance foot at the origin, and compare each step with amble's run
-    from the same state (:class:`StepDrift`). MuJoCo's contact is soft (its default ``solref``,
-    ``solimp``), its integrator ``implicitfast`` with step ``timestep`` (s); see
-    :func:`planar_biped_mjcf` for ``foot_radius`` and ``friction``.
+    from the same state (:class:`StepDrift`). MuJoCo's contact is soft (a spring-damper of time
+    constant ``contact_time``, s, and MuJoCo's default ``solimp``), its integrator
+    ``implicitfast`` with step ``timestep`` (s); see :func:`planar_biped_mjcf` for
+    ``foot_radius`` and ``friction``.
     """
     if not 1 <= int(steps) <= 10000:
         raise ParameterError(f"steps must be at least 1 and at most 10000, got {steps}")
@@ -308,52 +366,45 @@ def replay_in_mujoco(system: Any, steps: int = 10, *, params: Mapping[str, float
     x0 = np.asarray(system.default_start[system.mode_names[0]] if x0 is None else x0, dtype=float)
     if x0.shape != (2 * len(COORDINATES),):
         raise ParameterError(f"x0 must have {2 * len(COORDINATES)} values (state_names order), got {x0.size}")
-    symbolic = system.symbolic()
-    joints_of = dict(zip(COORDINATES, MUJOCO_JOINTS[2:3] + ("hip_a", "hip_b", "knee_a", "knee_b")))
-    limits: dict[str, float | None] = {}
-    for model in symbolic.modes.values():
-        for a in getattr(model, "actuators", []):
-            coord = str(a.on)
-            if coord not in COORDINATES[1:]:
-                raise ModelError(f"model {system.name!r}: input {a.symbol} must drive one joint coordinate")
-            limits[joints_of[coord]] = a.limit
-    for s, w in (("a", "b"), ("b", "a")):  # both legs get the limit of the role they take
-        limits[f"hip_{s}"] = limits.get(f"hip_{s}") or limits.get(f"hip_{w}")
-        limits[f"knee_{s}"] = limits.get(f"knee_{s}") or limits.get(f"knee_{w}")
+    limits = _limits(system)
     xml = planar_biped_mjcf(system, values, foot_radius=foot_radius, friction=friction, timestep=timestep,
-                            limits=limits)
-    ref, starts, lengths = _reference(system, x0, values, steps, timestep)
-    amble_times = np.diff(starts)
+                            contact_time=contact_time, limits=limits)
+    ref = _Reference(system, x0, values, steps, timestep)
     walk = _Walk(system, values, xml, x0)
+    bound = np.array([limits.get(MUJOCO_JOINTS[i]) or np.inf for i in range(3, len(MUJOCO_JOINTS))])
+    return _walk(walk, ref, steps, bound, xml)
+
+
+def _walk(walk: _Walk, ref: _Reference, steps: int, bound: np.ndarray, xml: str) -> MujocoReplay:
+    """MuJoCo's steps one after the other, each compared with amble's when its footfall comes."""
     hip_height = float(walk.d.site_xpos[walk.hip, 2])
-    patience = 3.0 * (float(np.mean(amble_times)) if len(amble_times) else 1.0)
+    patience = 3.0 * ref.mean_step_time()
+    shortest = 0.2 * ref.mean_step_time()  # a touch sooner is the swing foot leaving, not landing
+    dt = float(walk.m.opt.timestep)
     drift: list[StepDrift] = []
     t_step, samples_t, samples_q = 0.0, [], []
     stance_start, deepest, max_u, status = walk.foot(0), 0.0, 0.0, "completed"
+    x, clipped = walk.state(), 0
     while len(drift) < steps:
-        max_u = max(max_u, float(np.max(np.abs(walk.control()))))
+        u = np.abs(walk.control(x))
+        max_u = max(max_u, float(u.max()))
+        clipped += bool(np.any(u > bound[np.asarray(walk.motor[walk.stance])]))
         walk.mj.mj_step(walk.m, walk.d)
-        t = float(walk.d.time)
+        t, x = float(walk.d.time), walk.state()
         samples_t.append(t - t_step)
-        samples_q.append(walk.state()[:5])
+        samples_q.append(x[: len(COORDINATES)])
         deepest = max(deepest, -float(walk.foot(walk.stance)[1]))
         if walk.d.site_xpos[walk.hip, 2] < 0.5 * hip_height or t - t_step > patience:
             status = "fell"
             break
-        if not walk.touchdown() or t - t_step < 0.2 * patience / 3.0:
+        if t - t_step < shortest or not walk.touchdown():
             continue
         k = len(drift)
         swing, stance = walk.foot(1 - walk.stance), walk.foot(walk.stance)
-        rms = float("nan")
-        if k < len(amble_times):
-            ta, qa = _segment(ref, starts[k], starts[k + 1])
-            tm = np.asarray(samples_t)
-            keep = tm <= min(ta[-1], tm[-1])
-            qi = np.column_stack([np.interp(tm[keep], ta, qa[:, j]) for j in range(5)])
-            rms = float(np.sqrt(np.mean((np.asarray(samples_q)[keep] - qi) ** 2)))
-        drift.append(StepDrift(k, t - t_step, float(amble_times[k]) if k < len(amble_times) else float("nan"),
-                               float(swing[0] - stance[0]), float(lengths[k]) if k < len(lengths) else float("nan"),
-                               rms, float(abs(stance[0] - stance_start[0])), deepest))
+        rms = ref.angle_rms(k, np.asarray(samples_t), np.asarray(samples_q))
+        drift.append(StepDrift(k, t - t_step, ref.step(k)[0], float(swing[0] - stance[0]), ref.step(k)[1], rms,
+                               float(abs(stance[0] - stance_start[0])), deepest))
         walk.stance = 1 - walk.stance
+        x = walk.state()
         t_step, samples_t, samples_q, stance_start, deepest = t, [], [], swing, 0.0
-    return MujocoReplay(status, len(drift), drift, max_u, float(walk.d.time), xml)
+    return MujocoReplay(status, len(drift), drift, max_u, clipped * dt, float(walk.d.time), xml)

@@ -1,0 +1,102 @@
+"""RABBIT exported to MuJoCo: MuJoCo is the independent oracle of the exported robot's dynamics, and
+the HZD gait replayed there on soft ground walks.
+
+amble's RABBIT is pinned at its stance foot (5 coordinates); the export is free in the plane
+(7: hip x, hip z, torso pitch, two hips, two knees). With the foot held, MuJoCo's velocities are
+``v = J q̇`` where ``J`` is read from MuJoCo's own foot Jacobian ``J_c`` (``J_c v = 0``: the hip's
+rates are ``−J_c,rest q̇``, the joints map one to one), and its accelerations ``J q̈ + a`` with
+``a = −J̇_c v`` on the hip rows (``mj_jacDot``). Then amble's ``M`` and ``h`` must be ``Jᵀ M_mj J``
+and ``Jᵀ (M_mj a + qfrc_bias)`` — MuJoCo's composite rigid body and recursive Newton–Euler on the
+exported bodies, nothing of amble's derivation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from amble.analysis.mujoco_replay import mujoco_state, planar_biped_mjcf, replay_in_mujoco
+from amble.backend.kernels import compiled
+from amble.errors import ModelError, ParameterError
+from amble.models import load
+from amble.simulation.simulate import parameter_vector
+
+mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is the reference; not installed")
+
+#: amble's coordinates (torso stance_hip swing_hip stance_knee swing_knee) → MuJoCo's velocity index
+#: while leg a stands (MuJoCo: rootx rootz torso hip_a knee_a hip_b knee_b), written out here
+_ROWS = [2, 3, 5, 4, 6]
+
+
+def _full_mass_matrix(m, d) -> np.ndarray:
+    out = np.zeros((m.nv, m.nv))
+    try:
+        mujoco.mj_fullM(m, d, out)  # MuJoCo 4
+    except TypeError:
+        mujoco.mj_fullM(m, out, d.qM)  # MuJoCo 3
+    return out
+
+
+@pytest.fixture(scope="module")
+def rabbit():
+    return load("rabbit")
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_exported_dynamics_are_amble_s(rabbit, seed):
+    params = {"mT": 18.0, "lf": 0.42, "pt": 0.11, "It": 0.8}  # not the defaults: every value reaches the file
+    k = compiled(rabbit)
+    p = parameter_vector(k, params, rabbit)
+    values = {**rabbit.parameters, **params}
+    m = mujoco.MjModel.from_xml_string(planar_biped_mjcf(rabbit, params))
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(seed)
+    x = np.concatenate([rng.uniform(-0.6, 0.6, 5), rng.uniform(-2.0, 2.0, 5)])
+    d.qpos[:], d.qvel[:] = mujoco_state(x, values, 0, foot=(0.3, 0.0))
+    mujoco.mj_forward(m, d)
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "foot_a")
+    body = int(m.site_bodyid[site])
+    jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+    mujoco.mj_jacSite(m, d, jacp, jacr, site)
+    Jc = jacp[[0, 2]]
+    # the state map puts the stance foot where it was asked, at rest
+    np.testing.assert_allclose(d.site_xpos[site][[0, 2]], [0.3, 0.0], atol=1e-12)
+    np.testing.assert_allclose(Jc @ d.qvel, 0.0, atol=1e-12)
+    np.testing.assert_allclose(Jc[:, :2], np.eye(2), atol=1e-12)  # the slides move the foot as themselves
+    J = np.zeros((m.nv, 5))
+    J[_ROWS, range(5)] = 1.0
+    J[:2] = -Jc[:, _ROWS]
+    dp, dr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+    mujoco.mj_jacDot(m, d, dp, dr, d.site_xpos[site], body)
+    a = np.zeros(m.nv)
+    a[:2] = -(dp[[0, 2]] @ d.qvel)
+    Mmj = _full_mass_matrix(m, d)
+    M, h, _ = k.dynamics("rabbit", 0.0, x, p)
+    scale = np.max(np.abs(M))
+    np.testing.assert_allclose(J.T @ Mmj @ J, M, rtol=0, atol=1e-10 * scale)
+    np.testing.assert_allclose(J.T @ (Mmj @ a + d.qfrc_bias), h, rtol=0, atol=1e-9 * np.max(np.abs(h)))
+
+
+def test_hzd_gait_walks_ten_steps_in_mujoco(rabbit):
+    r = replay_in_mujoco(rabbit, steps=10)
+    assert r.status == "completed" and r.steps == 10
+    s = r.summary()
+    # soft contact with the default stiffness: the step stays 0.395 m, the step time within 10 %,
+    # the stance foot holds (slip and sinking of a few mm at most)
+    assert s["max_step_length_error"] < 2e-3
+    assert s["max_step_time_error"] < 0.1 * r.drift[0].amble_step_time
+    assert s["max_angle_rms"] < 0.1
+    assert s["max_stance_slip"] < 5e-3 and s["max_penetration"] < 5e-3
+    # the law meets each soft footfall with the velocities before the impact: clipped for a few ms
+    assert r.max_input > 150.0 and 0 < r.saturated_time < 0.01 * r.time
+
+
+def test_other_layouts_and_bad_settings_are_refused(rabbit):
+    with pytest.raises(ModelError, match="RABBIT's layout"):
+        planar_biped_mjcf(load("compass-gait"))
+    with pytest.raises(ParameterError, match="slope"):
+        planar_biped_mjcf(rabbit, {"slope": 0.1})
+    with pytest.raises(ParameterError, match="contact_time"):
+        planar_biped_mjcf(rabbit, contact_time=1e-4)
+    with pytest.raises(ParameterError, match="unknown parameter"):
+        planar_biped_mjcf(rabbit, {"nope": 1.0})
