@@ -53,6 +53,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("hybrid_invariance_error", "invariant_parameters", "restricted_map"), ".analysis.hzd"),
     "optimize_gait": ".analysis.gait_optimisation",
     **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
+    **dict.fromkeys(("MujocoReplay", "planar_biped_mjcf", "replay_in_mujoco"), ".analysis.mujoco_replay"),
     "gait_gradients": ".analysis.gait_gradients",
     "check_gait": ".analysis.gait_check",
     "simulate": ".simulation.simulate",

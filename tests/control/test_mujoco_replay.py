@@ -12,6 +12,8 @@ exported bodies, nothing of amble's derivation.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -100,3 +102,18 @@ def test_other_layouts_and_bad_settings_are_refused(rabbit):
         planar_biped_mjcf(rabbit, contact_time=1e-4)
     with pytest.raises(ParameterError, match="unknown parameter"):
         planar_biped_mjcf(rabbit, {"nope": 1.0})
+
+
+def test_command_writes_the_model_and_reports_per_step(capsys, tmp_path):
+    from amble.cli.main import main
+
+    path = tmp_path / "rabbit.xml"
+    assert main(["mujoco", "rabbit", "--steps", "2", "--mjcf", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "completed" and out["steps"] == 2 and len(out["per_step"]) == 2
+    assert abs(out["per_step"][0]["step_length"] - out["per_step"][0]["amble_step_length"]) < 2e-3
+    m = mujoco.MjModel.from_xml_path(str(path))  # the file is a MuJoCo model of the robot
+    assert m.nq == 7 and m.nu == 4 and abs(sum(m.body_mass) - (20.0 + 2 * 6.8 + 2 * 3.2)) < 1e-12
+    assert main(["mujoco", "rabbit", "--steps", "0"]) == 2
+    assert main(["mujoco", "rabbit", "--start", "x0=1,,2"]) == 2
+    assert "amble: error:" in capsys.readouterr().err

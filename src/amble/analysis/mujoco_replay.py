@@ -37,6 +37,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ModelError, ParameterError
+from .defaults import MUJOCO_CONTACT_TIME as CONTACT_TIME
+from .defaults import MUJOCO_TIMESTEP as TIMESTEP
 
 #: amble's coordinates of the exported layout, in order, and the MuJoCo joint each one is while leg
 #: ``a`` stands (leg ``b`` standing swaps ``a`` and ``b``)
@@ -46,8 +48,6 @@ _JOINT_OF = {"torso": "torso", "stance_hip": "hip_{s}", "swing_hip": "hip_{w}", 
 #: MuJoCo's generalized coordinates of the export, in order
 MUJOCO_JOINTS = ("rootx", "rootz", "torso", "hip_a", "knee_a", "hip_b", "knee_b")
 _PARAMETERS = ("mT", "mf", "mt", "lf", "lt", "pT", "pf", "pt", "IT", "If", "It", "g")
-#: MuJoCo's step (s) and the contact's time constant (s) of a replay: a stiff contact, integrated finely
-TIMESTEP, CONTACT_TIME = 2e-4, 5e-3
 #: the torso's drawn length (m; RABBIT's head point)
 _TORSO_LENGTH = 0.625
 

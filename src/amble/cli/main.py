@@ -27,6 +27,8 @@ from .gaits import EXAMPLE as GAITS_EXAMPLE
 from .gaits import add_parser as add_gaits_parser
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
+from .mujoco import EXAMPLE as MUJOCO_EXAMPLE
+from .mujoco import add_parser as add_mujoco_parser
 from .output import gait_check_lines, write_output
 
 #: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
@@ -234,6 +236,7 @@ EXAMPLES = {
     "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
     "gaits": GAITS_EXAMPLE,
     "mfpt": MFPT_EXAMPLE,
+    "mujoco": MUJOCO_EXAMPLE,
     "cache": "amble cache clear --older-than 30 --dry-run",
 }
 
@@ -376,6 +379,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     add_gait_parser(add, model_arg)
     add_gaits_parser(add, model_arg)
     add_mfpt_parser(add, model_arg)
+    add_mujoco_parser(add, model_arg)
     add_cache_parser(add)
     return p
 
