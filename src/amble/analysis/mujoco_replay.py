@@ -195,8 +195,11 @@ def amble_state(qpos: np.ndarray, qvel: np.ndarray, stance: int) -> np.ndarray:
 class StepDrift:
     """One step of both runs: MuJoCo's and amble's step time (s) and step length (m, foot to
     foot at the footfall), the RMS difference of the five angles over the step (rad, at equal
-    time since the step began, over the shorter of the two steps), and MuJoCo's stance foot:
-    how far it slid along the ground (m) and how deep it sank at most (m)."""
+    time since the step began, over the shorter of the two steps), MuJoCo's stance foot: how
+    far it slid along the ground (m) and how deep it sank at most (m), and — for a law of virtual
+    constraints — the largest output error ``|y|`` over the step in MuJoCo (rad; amble's gait
+    keeps ``y = 0``: it measures how far the soft footfall throws the robot off the zero
+    dynamics), NaN without them."""
 
     step: int
     step_time: float
@@ -206,6 +209,7 @@ class StepDrift:
     angle_rms: float
     stance_slip: float
     penetration: float
+    max_output: float
 
     def to_json(self) -> dict[str, Any]:
         return {k: (float(v) if k != "step" else int(v)) for k, v in self.__dict__.items()}
@@ -230,7 +234,7 @@ class MujocoReplay:
 
     def summary(self) -> dict[str, float]:
         """The largest drift over the steps: ``|Δ step time|`` (s), ``|Δ step length|`` (m), angle
-        RMS (rad), stance-foot slip and penetration (m)."""
+        RMS (rad), stance-foot slip and penetration (m), output error ``|y|`` (rad)."""
         d = self.drift
         if not d:
             return {}
@@ -238,6 +242,7 @@ class MujocoReplay:
                 "max_step_length_error": max(abs(s.step_length - s.amble_step_length) for s in d),
                 "max_angle_rms": max(s.angle_rms for s in d),
                 "max_stance_slip": max(s.stance_slip for s in d),
+                "max_output": max(s.max_output for s in d),
                 "max_penetration": max(s.penetration for s in d)}
 
     def to_json(self) -> dict[str, Any]:
@@ -307,6 +312,13 @@ class _Walk:
         self.sites = [mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_SITE, f"foot_{s}") for s in "ab"]
         self.hip = mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_SITE, "hip")
         # the motor of each amble coordinate, per stance leg (the torso has none)
+        model = system.symbolic().modes[self.mode]
+        self.outputs = None
+        if getattr(model, "virtual", None) is not None:
+            import sympy as sp  # the outputs alone: y(q) needs no derivation
+
+            self.outputs = sp.lambdify([*model.q, *model.params], list(model.virtual.y), "numpy", cse=True)
+            self.output_params = [dict(values)[str(q)] for q in model.params]
         acts = [mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_ACTUATOR, j) for j in MUJOCO_JOINTS[3:]]
         self.motor = [[acts[MUJOCO_JOINTS[3:].index(MUJOCO_JOINTS[i])] for i in _joint_order(s)[1:]] for s in (0, 1)]
 
@@ -326,6 +338,13 @@ class _Walk:
         if xpos[self.sites[1 - self.stance], 0] <= xpos[self.sites[self.stance], 0] or not self.d.ncon:
             return False
         return bool(np.any(self.d.contact.geom[: self.d.ncon] == swing))
+
+    def max_output(self, x: np.ndarray) -> float:
+        """The largest ``|y|`` of the virtual constraints over the states ``x`` (rows; rad)."""
+        if self.outputs is None or not len(x):
+            return float("nan")
+        y = self.outputs(*np.asarray(x)[:, : len(COORDINATES)].T, *self.output_params)
+        return float(max(np.max(np.abs(v)) for v in y))
 
     def foot(self, which: int) -> np.ndarray:
         return self.d.site_xpos[self.sites[which]][[0, 2]].copy()
@@ -392,7 +411,7 @@ def _walk(walk: _Walk, ref: _Reference, steps: int, bound: np.ndarray, xml: str)
         walk.mj.mj_step(walk.m, walk.d)
         t, x = float(walk.d.time), walk.state()
         samples_t.append(t - t_step)
-        samples_q.append(x[: len(COORDINATES)])
+        samples_q.append(x)
         deepest = max(deepest, -float(walk.foot(walk.stance)[1]))
         if walk.d.site_xpos[walk.hip, 2] < 0.5 * hip_height or t - t_step > patience:
             status = "fell"
@@ -401,9 +420,10 @@ def _walk(walk: _Walk, ref: _Reference, steps: int, bound: np.ndarray, xml: str)
             continue
         k = len(drift)
         swing, stance = walk.foot(1 - walk.stance), walk.foot(walk.stance)
-        rms = ref.angle_rms(k, np.asarray(samples_t), np.asarray(samples_q))
+        xs = np.asarray(samples_q)
+        rms = ref.angle_rms(k, np.asarray(samples_t), xs[:, : len(COORDINATES)])
         drift.append(StepDrift(k, t - t_step, ref.step(k)[0], float(swing[0] - stance[0]), ref.step(k)[1], rms,
-                               float(abs(stance[0] - stance_start[0])), deepest))
+                               float(abs(stance[0] - stance_start[0])), deepest, walk.max_output(xs)))
         walk.stance = 1 - walk.stance
         x = walk.state()
         t_step, samples_t, samples_q, stance_start, deepest = t, [], [], swing, 0.0

@@ -66,8 +66,8 @@ def cmd_mujoco(args: argparse.Namespace) -> dict[str, Any]:
                   f"{s['max_step_length_error'] * 1e3:.3g} mm, angle RMS {s['max_angle_rms']:.3g} rad")
             print(f"  stance foot: slip {s['max_stance_slip'] * 1e3:.3g} mm, sinks {s['max_penetration'] * 1e3:.3g} mm;"
                   f" inputs clipped {r.saturated_time * 1e3:.3g} ms (law's largest {r.max_input:.4g} N·m)")
-        print("  step  time [s] (amble)   length [m] (amble)   angle RMS [rad]")
+        print("  step  time [s] (amble)   length [m] (amble)   angle RMS [rad]   max |y| [rad]")
         for d in r.drift:
             print(f"  {d.step:4d}  {d.step_time:.4f} ({d.amble_step_time:.4f})   {d.step_length:.4f} "
-                  f"({d.amble_step_length:.4f})     {d.angle_rms:.4f}")
+                  f"({d.amble_step_length:.4f})     {d.angle_rms:.4f}            {d.max_output:.4f}")
     return out
