@@ -119,3 +119,31 @@ def test_command_writes_the_model_and_reports_per_step(capsys, tmp_path):
     assert main(["mujoco", "rabbit", "--steps", "0"]) == 2
     assert main(["mujoco", "rabbit", "--start", "x0=1,,2"]) == 2
     assert "amble: error:" in capsys.readouterr().err
+
+
+def test_a_model_with_rabbit_s_names_but_other_mechanics_is_refused():
+    from amble import Model, R, walker
+
+    m = Model("not-rabbit")
+    T, hst, hsw, kst, ksw = m.coordinates("torso stance_hip swing_hip stance_knee swing_knee")
+    mT, mf, mt, lf, lt, pT, pf, pt, IT, If, It, g = m.parameters(
+        mT=20.0, mf=6.8, mt=3.2, lf=0.4, lt=0.4, pT=0.2, pf=0.163, pt=0.128, IT=2.22, If=1.08, It=0.93, g=9.81)
+    f1, t1, f2, t2 = T + hst, T + hst + kst, T + hsw, T + hsw + ksw
+    m.point("stance_foot", (0, 0))
+    knee1 = m.point("stance_knee_joint", lt * R(t1), link="stance_foot")
+    hip = m.point("hip", knee1 + lf * R(f1), link="stance_knee_joint")
+    m.point("torso_com", hip + pT * R(T), mass=mT)
+    m.point("stance_femur_com", hip - pf * R(f1), mass=mf)
+    m.point("stance_tibia_com", knee1 - pt * R(t1), mass=mt)
+    knee2 = m.point("swing_knee_joint", hip - lf * R(f2), link="hip")
+    m.point("swing_femur_com", hip - pf * R(f2), mass=mf)
+    m.point("swing_tibia_com", knee2 - 2 * pt * R(t2), mass=mt)  # not where the export puts it
+    m.point("swing_foot", knee2 - lt * R(t2), link="swing_knee_joint")
+    for angle, inertia in ((T, IT), (f1, If), (t1, It), (f2, If), (t2, It)):
+        m.inertia(angle, inertia)
+    m.gravity(g)
+    other = walker(m, foot="swing_foot", hip="hip", slope=0.0,
+                   relabel={T: T, hst: hsw, hsw: hst, kst: ksw, ksw: kst})
+    x0 = [0.1, -0.4, 0.1, 0.1, 0.1, 0.6, 0.8, 0.2, -1.0, 0.2]
+    with pytest.raises(ModelError, match="not the exported biped's"):
+        replay_in_mujoco(other, 1, x0=x0)

@@ -325,6 +325,35 @@ class _Walk:
     def state(self) -> np.ndarray:
         return amble_state(self.d.qpos, self.d.qvel, self.stance)
 
+    def check(self, system: Any) -> None:
+        """Refuse a model whose names are RABBIT's but whose mechanics are not the export's: with
+        the stance foot held, MuJoCo's ``M`` and bias must be amble's at the start (1e-8).
+
+        MuJoCo's velocities are ``J q̇`` with ``J`` from its foot Jacobian ``J_c`` (``J_c J = 0``,
+        joints one to one), its accelerations ``J q̈ − J̇_c q̇`` on the root's slides."""
+        mj, m, d = self.mj, self.m, self.d
+        site = self.sites[self.stance]
+        jp, jr, dp, dr = (np.zeros((3, m.nv)) for _ in range(4))
+        mj.mj_jacSite(m, d, jp, jr, site)
+        mj.mj_jacDot(m, d, dp, dr, d.site_xpos[site], int(m.site_bodyid[site]))
+        rows = _joint_order(self.stance)
+        J = np.zeros((m.nv, len(rows)))
+        J[rows, range(len(rows))] = 1.0
+        J[:2] = -jp[[0, 2]][:, rows]  # the root's slides move the foot as themselves
+        a = np.zeros(m.nv)
+        a[:2] = -(dp[[0, 2]] @ d.qvel)
+        full = np.zeros((m.nv, m.nv))
+        try:
+            mj.mj_fullM(m, d, full)  # MuJoCo 4
+        except TypeError:
+            mj.mj_fullM(m, full, d.qM)  # MuJoCo 3
+        M, h, _ = self.k.dynamics(self.mode, 0.0, self.state(), self.p)
+        err = max(np.max(np.abs(J.T @ full @ J - M)) / np.max(np.abs(M)),
+                  np.max(np.abs(J.T @ (full @ a + d.qfrc_bias) - h)) / max(np.max(np.abs(h)), 1.0))
+        if not err < 1e-8:
+            raise ModelError(f"model {system.name!r}: its mechanics are not the exported biped's (mass matrix "
+                             f"or bias differ by {err:.2g} relative): the export knows RABBIT's layout only")
+
     def control(self, x: np.ndarray) -> np.ndarray:
         """amble's law at amble's state ``x``: ``Γ + B u`` on the joints (N·m)."""
         _, _, gamma = self.k.dynamics(self.mode, float(self.d.time), x, self.p)
@@ -388,8 +417,9 @@ def replay_in_mujoco(system: Any, steps: int = 10, *, params: Mapping[str, float
     limits = _limits(system)
     xml = planar_biped_mjcf(system, values, foot_radius=foot_radius, friction=friction, timestep=timestep,
                             contact_time=contact_time, limits=limits)
-    ref = _Reference(system, x0, values, steps, timestep)
     walk = _Walk(system, values, xml, x0)
+    walk.check(system)
+    ref = _Reference(system, x0, values, steps, timestep)
     bound = np.array([limits.get(MUJOCO_JOINTS[i]) or np.inf for i in range(3, len(MUJOCO_JOINTS))])
     return _walk(walk, ref, steps, bound, xml)
 
