@@ -147,3 +147,34 @@ def test_a_model_with_rabbit_s_names_but_other_mechanics_is_refused():
     x0 = [0.1, -0.4, 0.1, 0.1, 0.1, 0.6, 0.8, 0.2, -1.0, 0.2]
     with pytest.raises(ModelError, match="not the exported biped's"):
         replay_in_mujoco(other, 1, x0=x0)
+
+
+def test_amble_reads_the_exported_file_back_as_rabbit(rabbit, tmp_path):
+    """amble's own MJCF import of the export, pinned at the stance foot, is RABBIT again: the
+    conventions of the export and of the import (axes, signs, ``qpos``) are one."""
+    import warnings
+
+    from amble import HybridSystem, Model
+
+    path = tmp_path / "rabbit.xml"
+    path.write_text(planar_biped_mjcf(rabbit), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the motors: the import reads no actuators
+        tree = Model.from_mjcf(path)
+    assert [str(q) for q in tree.q] == ["rootx", "rootz", "torso", "hip_a", "knee_a", "hip_b", "knee_b"]
+    kt, kr = compiled(HybridSystem(tree.name, tree)), compiled(rabbit)
+    x = np.array([0.1, -0.4, 0.1, 0.1, 0.1, 0.6105463, 0.82904739, 0.15687426, -1.07386594, 0.20003823])
+    qpos, qvel = mujoco_state(x, rabbit.parameters, 0)
+    Mt, _, _ = kt.dynamics(0, 0.0, np.concatenate([qpos, qvel]), np.zeros(1))
+    M, _, _ = kr.dynamics("rabbit", 0.0, x, parameter_vector(kr, {}, rabbit))
+    # with the foot held: q̇_tree = J q̇, J from the legs' geometry (hip = foot + lt R(θ_tibia) + lf R(θ_femur))
+    eps = 1e-6
+    J = np.column_stack([(mujoco_state(x + eps * np.eye(10)[i], rabbit.parameters, 0)[0]
+                          - mujoco_state(x - eps * np.eye(10)[i], rabbit.parameters, 0)[0]) / (2 * eps)
+                         for i in range(5)])
+    np.testing.assert_allclose(J.T @ Mt @ J, M, rtol=0, atol=1e-7 * np.max(np.abs(M)))
+    # at rest only gravity is left in h: the import pulls the same way (J̇ q̇ = 0)
+    rest = np.concatenate([x[:5], np.zeros(5)])
+    _, gt, _ = kt.dynamics(0, 0.0, np.concatenate([qpos, np.zeros(7)]), np.zeros(1))
+    _, g, _ = kr.dynamics("rabbit", 0.0, rest, parameter_vector(kr, {}, rabbit))
+    np.testing.assert_allclose(J.T @ gt, g, rtol=0, atol=1e-7 * np.max(np.abs(g)))
