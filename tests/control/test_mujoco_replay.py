@@ -178,3 +178,10 @@ def test_amble_reads_the_exported_file_back_as_rabbit(rabbit, tmp_path):
     _, gt, _ = kt.dynamics(0, 0.0, np.concatenate([qpos, np.zeros(7)]), np.zeros(1))
     _, g, _ = kr.dynamics("rabbit", 0.0, rest, parameter_vector(kr, {}, rabbit))
     np.testing.assert_allclose(J.T @ gt, g, rtol=0, atol=1e-7 * np.max(np.abs(g)))
+
+
+def test_a_start_far_off_the_gait_falls_in_mujoco_and_says_so(rabbit):
+    x0 = [0.1, -0.4, 0.1, 0.1, 0.1, -2.6, 0.83, 0.16, -1.07, 0.2]  # the torso thrown backwards
+    r = replay_in_mujoco(rabbit, 3, x0=x0)
+    assert r.status == "fell" and r.steps < 3
+    json.dumps(r.to_json(), allow_nan=False)  # no NaN in the JSON

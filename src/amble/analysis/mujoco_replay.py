@@ -191,6 +191,10 @@ def amble_state(qpos: np.ndarray, qvel: np.ndarray, stance: int) -> np.ndarray:
     return np.concatenate([qpos[idx], qvel[idx]])
 
 
+def _number(v: float) -> float | None:
+    return float(v) if np.isfinite(v) else None
+
+
 @dataclass
 class StepDrift:
     """One step of both runs: MuJoCo's and amble's step time (s) and step length (m, foot to
@@ -212,13 +216,15 @@ class StepDrift:
     max_output: float
 
     def to_json(self) -> dict[str, Any]:
-        return {k: (float(v) if k != "step" else int(v)) for k, v in self.__dict__.items()}
+        """The fields as JSON numbers (NaN, where amble's run has no such step, as null)."""
+        return {k: (int(v) if k == "step" else _number(v)) for k, v in self.__dict__.items()}
 
 
 @dataclass
 class MujocoReplay:
     """The outcome of :func:`replay_in_mujoco`: ``status`` ``completed`` (all steps walked) or
-    ``fell`` (hip below half its standing height, or no footfall in three amble step times),
+    ``fell`` (hip below half its height at the start, the torso beyond horizontal, or no footfall
+    in three amble step times),
     the steps walked, their drift from amble's run, the largest input the law asked for (N·m;
     MuJoCo clips it to the declared limits), how long any input was clipped in all (s; the law
     meets each soft footfall with the velocities before the impact, for a few ms), the time
@@ -235,19 +241,23 @@ class MujocoReplay:
     def summary(self) -> dict[str, float]:
         """The largest drift over the steps: ``|Δ step time|`` (s), ``|Δ step length|`` (m), angle
         RMS (rad), stance-foot slip and penetration (m), output error ``|y|`` (rad)."""
+
+        def worst(values: Any) -> float:  # NaN where amble's run has no such step
+            return max((v for v in values if np.isfinite(v)), default=float("nan"))
+
         d = self.drift
         if not d:
             return {}
-        return {"max_step_time_error": max(abs(s.step_time - s.amble_step_time) for s in d),
-                "max_step_length_error": max(abs(s.step_length - s.amble_step_length) for s in d),
-                "max_angle_rms": max(s.angle_rms for s in d),
-                "max_stance_slip": max(s.stance_slip for s in d),
-                "max_output": max(s.max_output for s in d),
-                "max_penetration": max(s.penetration for s in d)}
+        return {"max_step_time_error": worst(abs(s.step_time - s.amble_step_time) for s in d),
+                "max_step_length_error": worst(abs(s.step_length - s.amble_step_length) for s in d),
+                "max_angle_rms": worst(s.angle_rms for s in d),
+                "max_stance_slip": worst(s.stance_slip for s in d),
+                "max_output": worst(s.max_output for s in d),
+                "max_penetration": worst(s.penetration for s in d)}
 
     def to_json(self) -> dict[str, Any]:
         return {"status": self.status, "steps": self.steps, "time": self.time, "max_input": self.max_input,
-                "saturated_time": self.saturated_time, "drift": self.summary(),
+                "saturated_time": self.saturated_time, "drift": {k: _number(v) for k, v in self.summary().items()},
                 "per_step": [s.to_json() for s in self.drift]}
 
 
@@ -443,7 +453,7 @@ def _walk(walk: _Walk, ref: _Reference, steps: int, bound: np.ndarray, xml: str)
         samples_t.append(t - t_step)
         samples_q.append(x)
         deepest = max(deepest, -float(walk.foot(walk.stance)[1]))
-        if walk.d.site_xpos[walk.hip, 2] < 0.5 * hip_height or t - t_step > patience:
+        if walk.d.site_xpos[walk.hip, 2] < 0.5 * hip_height or abs(x[0]) > np.pi / 2 or t - t_step > patience:
             status = "fell"
             break
         if t - t_step < shortest or not walk.touchdown():
