@@ -33,6 +33,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -123,7 +124,7 @@ def planar_biped_mjcf(system: Any, params: Mapping[str, float] | None = None, *,
         lim = (limits or {}).get(joint)
         rng = f' ctrlrange="{-lim!r} {lim!r}" ctrllimited="true"' if lim is not None else ' ctrllimited="false"'
         motors.append(f'    <motor name="{joint}" joint="{joint}" gear="1"{rng}/>')
-    return f"""<mujoco model="{system.name}">
+    return f"""<mujoco model={quoteattr(system.name)}>
   <compiler angle="radian" inertiafromgeom="false"/>
   <option timestep="{timestep!r}" gravity="0 0 {-v["g"]!r}" integrator="implicitfast"/>
   <worldbody>
@@ -162,13 +163,14 @@ def _joint_order(stance: int) -> list[int]:
 def mujoco_state(x: Sequence[float], values: Mapping[str, float], stance: int = 0,
                  foot: Sequence[float] = (0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """MuJoCo's ``(qpos, qvel)`` of amble's state ``x`` (``COORDINATES`` then their rates) with the
-    stance foot of leg ``stance`` at ``foot = (x, z)`` (m) and at rest: the hip is where the stance
-    leg puts it, ``hip = foot + lt R(θ_tibia) + lf R(θ_femur)``."""
+    stance foot of leg ``stance`` at ``foot = (x, z)`` (m) and not moving: the hip is where the
+    stance leg puts it, ``hip = foot + lt R(θ_tibia) + lf R(θ_femur)``, and moves as it carries it."""
     x = np.asarray(x, dtype=float)
     q, qd = x[:5], x[5:]
     f1, t1 = q[0] + q[1], q[0] + q[1] + q[3]
     f1d, t1d = qd[0] + qd[1], qd[0] + qd[1] + qd[3]
     lf, lt = values["lf"], values["lt"]
+
     def r(a: float) -> np.ndarray:  # amble's R(θ) in the (x, z) plane, and its derivative
         return np.array([np.sin(a), np.cos(a)])
 
