@@ -338,8 +338,9 @@ class _Walk:
         return amble_state(self.d.qpos, self.d.qvel, self.stance)
 
     def check(self, system: Any) -> None:
-        """Refuse a model whose names are RABBIT's but whose mechanics are not the export's: with
-        the stance foot held, MuJoCo's ``M`` and bias must be amble's at the start (1e-8).
+        """Refuse a model whose names are RABBIT's but whose mechanics are not the export's (or that
+        forces the torso's angle, which has no motor): with the stance foot held, MuJoCo's ``M``
+        and bias must be amble's at the start (1e-8).
 
         MuJoCo's velocities are ``J q̇`` with ``J`` from its foot Jacobian ``J_c`` (``J_c J = 0``,
         joints one to one), its accelerations ``J q̈ − J̇_c q̇`` on the root's slides."""
@@ -359,7 +360,10 @@ class _Walk:
             mj.mj_fullM(m, d, full)  # MuJoCo 4
         except TypeError:
             mj.mj_fullM(m, full, d.qM)  # MuJoCo 3
-        M, h, _ = self.k.dynamics(self.mode, 0.0, self.state(), self.p)
+        M, h, gamma = self.k.dynamics(self.mode, 0.0, self.state(), self.p)
+        if abs(gamma[0]) > 1e-9 * max(np.max(np.abs(gamma)), 1.0):
+            raise ModelError(f"model {system.name!r}: a generalized force acts on the torso's angle, which the "
+                             "export has no motor for")
         err = max(np.max(np.abs(J.T @ full @ J - M)) / np.max(np.abs(M)),
                   np.max(np.abs(J.T @ (full @ a + d.qfrc_bias) - h)) / max(np.max(np.abs(h)), 1.0))
         if not err < 1e-8:
