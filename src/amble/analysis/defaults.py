@@ -28,4 +28,9 @@ BASIN_STEPS = 60
 SWEEP_TOL = {"fixed-point": FIXED_POINT_TOL, "continuation": FIXED_POINT_TOL, "bifurcation": BIFURCATION_TOL,
              "basin": BASIN_TOL}
 
-__all__ = ["BASIN_STEPS", "BASIN_TOL", "BIFURCATION_TOL", "FIXED_POINT_TOL", "RESIDUAL_TOL", "SWEEP_TOL"]
+#: MuJoCo's step (s) and the time constant of its soft foot contact (s) in a replay
+#: (:mod:`amble.analysis.mujoco_replay`): a stiff contact, integrated with 25 steps per time constant.
+MUJOCO_TIMESTEP, MUJOCO_CONTACT_TIME = 2e-4, 5e-3
+
+__all__ = ["BASIN_STEPS", "BASIN_TOL", "BIFURCATION_TOL", "FIXED_POINT_TOL", "MUJOCO_CONTACT_TIME", "MUJOCO_TIMESTEP",
+           "RESIDUAL_TOL", "SWEEP_TOL"]

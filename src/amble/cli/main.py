@@ -29,6 +29,8 @@ from .gaits import EXAMPLE as GAITS_EXAMPLE
 from .gaits import add_parser as add_gaits_parser
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
+from .mujoco import EXAMPLE as MUJOCO_EXAMPLE
+from .mujoco import add_parser as add_mujoco_parser
 from .output import gait_check_lines, write_output
 from .robustness import EXAMPLE as ROBUSTNESS_EXAMPLE
 from .robustness import add_parser as add_robustness_parser
@@ -240,6 +242,7 @@ EXAMPLES = {
     "doublings": DOUBLINGS_EXAMPLE,
     "mfpt": MFPT_EXAMPLE,
     "robustness": ROBUSTNESS_EXAMPLE,
+    "mujoco": MUJOCO_EXAMPLE,
     "cache": "amble cache clear --older-than 30 --dry-run",
 }
 
@@ -384,6 +387,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     add_doublings_parser(add, model_arg)
     add_mfpt_parser(add, model_arg)
     add_robustness_parser(add, model_arg)
+    add_mujoco_parser(add, model_arg)
     add_cache_parser(add)
     return p
 
