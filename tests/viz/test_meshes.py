@@ -1,0 +1,215 @@
+"""Visual meshes of URDF robots in the 3D viewer.
+
+The loader is checked against trimesh reading the mesh file directly and placing it with the
+visual's origin built here from the URDF's roll-pitch-yaw convention (NumPy); the link poses
+against yourdfpy's own forward kinematics of the same file; the page against its size budget; and,
+in headless Chromium, Bolt's meshes are drawn and in frame.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+trimesh = pytest.importorskip("trimesh")
+yourdfpy = pytest.importorskip("yourdfpy")
+
+from test_html import HEIGHT, WIDTH, _chromium, _finish, _read_png, needs_chromium  # noqa: E402
+
+from amble import simulate  # noqa: E402
+from amble.models import load_robot  # noqa: E402
+from amble.viz.animate import scene_of  # noqa: E402
+from amble.viz.html import render_html, write_html  # noqa: E402
+from amble.viz.links import link_poses  # noqa: E402
+from amble.viz.meshes import decimate, decode, encode, urdf_visuals, within_budget  # noqa: E402
+
+
+def _robots() -> Path:
+    dist = importlib.metadata.distribution("example-robot-data")
+    f = next(f for f in dist.files or () if str(f).endswith("bolt.urdf"))
+    return Path(dist.locate_file(f)).parents[2]
+
+
+ROBOTS = _robots()
+BOLT = ROBOTS / "bolt_description" / "robots" / "bolt.urdf"
+LEG_STL = ROBOTS / "bolt_description" / "meshes" / "stl" / "upper_leg_200mm_left_side.stl"
+
+
+def _rpy(r: float, p: float, y: float) -> np.ndarray:
+    """URDF origin rotation: about fixed x by roll, then y by pitch, then z by yaw."""
+    cx, sx, cy, sy, cz, sz = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+XYZ, RPY, SCALE = np.array([0.1, -0.2, 0.3]), (0.3, -0.5, 1.1), np.array([1.0, 2.0, 0.5])
+
+
+def _urdf(tmp_path: Path) -> Path:
+    """A one-link robot with a scaled mesh (a package:// path) and three primitives, each at an
+    origin, in a ROS-like package layout."""
+    pkg = tmp_path / "my_robot"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "urdf").mkdir()
+    shutil.copy(LEG_STL, pkg / "meshes" / "leg.stl")
+    origin = f'<origin xyz="{" ".join(map(str, XYZ))}" rpy="{" ".join(map(str, RPY))}"/>'
+    text = f"""<robot name="probe">
+  <material name="red"><color rgba="0.9 0.1 0.1 1"/></material>
+  <link name="body">
+    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual>{origin}<geometry><mesh filename="package://my_robot/meshes/leg.stl" scale="1 2 0.5"/></geometry>
+      <material name="red"/></visual>
+    <visual>{origin}<geometry><box size="0.1 0.2 0.4"/></geometry></visual>
+    <visual>{origin}<geometry><cylinder radius="0.05" length="0.3"/></geometry>
+      <material name="c"><color rgba="0.2 0.3 0.4 0.5"/></material></visual>
+    <visual><origin xyz="0 0 1"/><geometry><sphere radius="0.07"/></geometry></visual>
+  </link>
+</robot>"""
+    path = pkg / "urdf" / "probe.urdf"
+    path.write_text(text)
+    return path
+
+
+def test_visuals_are_placed_by_their_origin_and_scale(tmp_path):
+    visuals = urdf_visuals(_urdf(tmp_path))
+    assert [v.link for v in visuals] == ["body"] * 4
+    mesh, box, cyl, ball = visuals
+    R = _rpy(*RPY)
+    raw = trimesh.load(str(LEG_STL), force="mesh")
+    expect = (np.asarray(raw.vertices) * SCALE) @ R.T + XYZ
+    assert mesh.vertices.shape == expect.shape and len(mesh.faces) == len(raw.faces)
+    np.testing.assert_allclose(mesh.vertices, expect, atol=1e-12)
+    np.testing.assert_allclose(mesh.vertices.min(axis=0), expect.min(axis=0), atol=1e-12)
+    assert mesh.color == (0.9, 0.1, 0.1)       # a material named at the robot's top
+    # primitives: back in the visual's own frame, the box's corners are at ±size/2 ...
+    local = (box.vertices - XYZ) @ R
+    np.testing.assert_allclose(np.abs(local).max(axis=0), [0.05, 0.1, 0.2], atol=1e-12)
+    np.testing.assert_allclose(np.abs(local), np.broadcast_to([0.05, 0.1, 0.2], local.shape), atol=1e-12)
+    # ... the cylinder's axis is z, radius 5 cm, 30 cm long, centred
+    local = (cyl.vertices - XYZ) @ R
+    r = np.hypot(local[:, 0], local[:, 1])
+    assert r.max() == pytest.approx(0.05, abs=1e-12) and np.ptp(local[:, 2]) == pytest.approx(0.3, abs=1e-12)
+    assert local[:, 2].min() == pytest.approx(-0.15, abs=1e-12)
+    assert (cyl.color, cyl.opacity) == ((0.2, 0.3, 0.4), 0.5)
+    np.testing.assert_allclose(np.linalg.norm(ball.vertices - [0, 0, 1], axis=1), 0.07, atol=1e-12)
+
+
+def test_package_paths_of_example_robot_data_resolve():
+    visuals = urdf_visuals(BOLT)
+    root = yourdfpy.URDF.load(str(BOLT), load_meshes=False, build_scene_graph=False).robot
+    expected = [lk.name for lk in root.links for v in lk.visuals]
+    assert [v.link for v in visuals] == expected and len(expected) == 9
+    counts = []
+    for lk in root.links:
+        for v in lk.visuals:
+            rel = v.geometry.mesh.filename.replace("package://example-robot-data/robots/", "")
+            counts.append(len(trimesh.load(str(ROBOTS / rel), force="mesh").faces))
+    assert [len(v.faces) for v in visuals] == counts
+
+
+def test_a_missing_mesh_is_left_out_with_a_warning(tmp_path):
+    path = _urdf(tmp_path)
+    (path.parents[1] / "meshes" / "leg.stl").unlink()
+    with pytest.warns(UserWarning, match="leg.stl.*not found"):
+        visuals = urdf_visuals(path)
+    assert len(visuals) == 3
+
+
+def test_decimation_keeps_the_shape_within_the_count():
+    sphere = trimesh.creation.icosphere(subdivisions=5)      # 20480 triangles of the unit sphere
+    v, f = decimate(sphere.vertices, sphere.faces, 2000)
+    assert 500 < len(f) <= 2000
+    r = np.linalg.norm(v, axis=1)
+    assert r.max() <= 1 + 1e-12 and r.min() > 0.9             # cluster means lie just inside
+    assert f.max() < len(v) and len(np.unique(f)) == len(v)    # no dangling vertex
+    small = trimesh.creation.box()
+    v, f = decimate(small.vertices, small.faces, 100)
+    assert len(f) == 12                                        # within the count: untouched
+
+
+def test_encoding_round_trips_to_a_fraction_of_the_quantum():
+    sphere = trimesh.creation.icosphere(subdivisions=3, radius=0.3)
+    enc = encode(sphere.vertices, sphere.faces)
+    v, f = decode(enc)
+    step = np.asarray(enc["step"])
+    assert np.all(np.abs(v - sphere.vertices) <= step / 2 + 1e-15)
+    np.testing.assert_array_equal(f, sphere.faces)
+    assert not enc["wide"] and enc["triangles"] == len(sphere.faces)
+
+
+@pytest.fixture(scope="module")
+def bolt_run():
+    system = load_robot(BOLT, fixed_base=True)
+    x0 = np.zeros(2 * 6)
+    x0[[1, 4]] = [0.6, -0.4]          # hip flexions: the legs swing apart
+    return simulate(system, x0, t_end=0.3)
+
+
+def test_link_poses_match_yourdfpy_forward_kinematics(bolt_run):
+    times = np.linspace(0.0, 0.3, 7)
+    poses = link_poses(bolt_run, times)
+    urdf = yourdfpy.URDF.load(str(BOLT), load_meshes=False)
+    q_names = [str(q) for q in bolt_run.system.modes[bolt_run.mode_names[0]].q]
+    for k, t in enumerate(times):
+        i = int(np.argmin(np.abs(bolt_run.t - t)))
+        assert bolt_run.t[i] == pytest.approx(t, abs=1e-12)   # times on the samples
+        urdf.update_cfg({n: float(bolt_run.x[i, j]) for j, n in enumerate(q_names)})
+        for link in urdf.link_map:
+            T = urdf.get_transform(link, "base_link")
+            p, R = poses[link]
+            np.testing.assert_allclose(p[k], T[:3, 3], atol=1e-12)
+            np.testing.assert_allclose(R[k], T[:3, :3], atol=1e-12)
+
+
+def test_bolt_page_holds_its_meshes_within_the_budget(bolt_run, tmp_path):
+    scene = scene_of(bolt_run, fps=30)
+    meshes = [s for s in scene["shapes"] if s["type"] == "mesh"]
+    assert len(meshes) == 9 and set(scene["meshes"]) == {s["mesh"] for s in meshes}
+    assert sum(m["triangles"] for m in scene["meshes"].values()) == sum(len(v.faces) for v in urdf_visuals(BOLT))
+    assert not any(s["type"] == "sphere" for s in scene["shapes"])   # no balls inside the meshes
+    page = render_html(scene)
+    assert scene["meshes"][meshes[0]["mesh"]]["positions"] in page
+    assert len(page.encode()) < 3_000_000
+    # the floor is under the lowest mesh vertex and the robot's size is the meshes' extent
+    ground = next(s for s in scene["shapes"] if s["type"] == "ground")
+    assert ground["height"] == pytest.approx(scene["bounds"]["min"][2], abs=1e-5)
+    assert 0.5 < scene["size"] < 1.2
+    bare = scene_of(bolt_run, fps=30, max_triangles=0)
+    assert "meshes" not in bare and any(s["type"] == "sphere" for s in bare["shapes"])
+
+
+def test_a_large_robot_is_reduced_to_the_budget():
+    visuals = urdf_visuals(ROBOTS / "solo_description" / "robots" / "solo12.urdf")
+    total = sum(len(v.faces) for v in visuals)
+    small = within_budget(visuals, 10_000)
+    assert total > 40_000 and sum(len(v.faces) for v in small) <= 10_000 + 48 * len(visuals)
+    for a, b in zip(visuals, small):   # each part keeps its place and size, to a cell
+        np.testing.assert_allclose(b.vertices.min(axis=0), a.vertices.min(axis=0), atol=0.01)
+        np.testing.assert_allclose(b.vertices.max(axis=0), a.vertices.max(axis=0), atol=0.01)
+
+
+@pytest.mark.browser
+@needs_chromium
+def test_bolts_meshes_are_drawn_in_frame(bolt_run, tmp_path):
+    scene = scene_of(bolt_run, fps=30, series=[])
+    for s in scene["shapes"]:
+        if s["type"] == "mesh":
+            s["color"] = [0.9, 0.1, 0.1]   # red: told apart from the floor and the sky
+    path = write_html(tmp_path / "bolt.html", scene)
+    png = tmp_path / "bolt.png"
+    _finish(_chromium(f"{path.as_uri()}#t=0.2&ui=0", f"--window-size={WIDTH},{HEIGHT}",
+                      "--virtual-time-budget=2000", f"--screenshot={png}", profile=tmp_path / "p"))
+    img = _read_png(png)
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    red = (r > 60) & (r > 1.8 * g) & (r > 1.8 * b)
+    assert red.sum() > 3000, f"only {red.sum()} pixels of mesh"
+    rows, cols = np.nonzero(red)
+    # in frame: clear of every border, and not a speck
+    assert rows.min() > 10 and cols.min() > 10 and rows.max() < HEIGHT - 10 and cols.max() < WIDTH - 10
+    assert rows.max() - rows.min() > HEIGHT / 5
