@@ -213,3 +213,61 @@ def test_bolts_meshes_are_drawn_in_frame(bolt_run, tmp_path):
     # in frame: clear of every border, and not a speck
     assert rows.min() > 10 and cols.min() > 10 and rows.max() < HEIGHT - 10 and cols.max() < WIDTH - 10
     assert rows.max() - rows.min() > HEIGHT / 5
+
+
+def _mjcf(tmp_path: Path) -> Path:
+    """A two-hinge arm with a mesh, a capsule, a box and a sphere, and a hidden geom (group 3)."""
+    shutil.copy(LEG_STL, tmp_path / "leg.stl")
+    text = """<mujoco model="arm">
+  <asset><mesh name="leg" file="leg.stl"/></asset>
+  <worldbody>
+    <geom type="plane" size="1 1 0.1"/>
+    <body name="upper" pos="0 0 1" euler="0.2 0 0.3">
+      <joint name="shoulder" type="hinge" axis="0 1 0" pos="0 0 0.05"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.03" rgba="0.9 0.1 0.1 1"/>
+      <geom type="mesh" mesh="leg" pos="0.05 0 -0.1" euler="0 0.4 0"/>
+      <body name="lower" pos="0 0 -0.4">
+        <joint name="elbow" type="hinge" axis="1 0 0"/>
+        <geom type="box" size="0.02 0.03 0.2" pos="0 0 -0.2"/>
+        <geom type="sphere" size="0.05" pos="0 0 -0.4"/>
+        <geom type="sphere" size="0.5" group="3"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+    path = tmp_path / "arm.xml"
+    path.write_text(text)
+    return path
+
+
+def test_mjcf_geoms_and_body_poses_match_mujoco(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    from amble.viz.meshes import mjcf_visuals
+
+    path = _mjcf(tmp_path)
+    visuals = mjcf_visuals(path)
+    assert [v.link for v in visuals] == ["upper", "upper", "lower", "lower"]   # no plane, no group 3
+    assert visuals[0].color == pytest.approx((0.9, 0.1, 0.1))
+    system = load_robot(path)
+    traj = simulate(system, [0.7, -0.5, 0.0, 0.0], t_end=0.2)
+    times = np.array([0.0, 0.1, 0.2])
+    poses = link_poses(traj, times)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    q_names = [str(q) for q in system.modes[traj.mode_names[0]].q]
+    for k, t in enumerate(times):
+        i = int(np.argmin(np.abs(traj.t - t)))
+        d.qpos[:] = m.qpos0 + traj.x[i, : len(q_names)]
+        mujoco.mj_kinematics(m, d)
+        for b, name in ((1, "upper"), (2, "lower")):
+            np.testing.assert_allclose(poses[name][0][k], d.xpos[b], atol=1e-12)
+            np.testing.assert_allclose(poses[name][1][k], d.xmat[b].reshape(3, 3), atol=1e-12)
+        # the mesh geom lands where MuJoCo puts it: its vertices through the body's pose, against
+        # MuJoCo's own geom frame applied to the mesh's vertices
+        g = 2
+        v0, nv = m.mesh_vertadr[0], m.mesh_vertnum[0]
+        expect = m.mesh_vert[v0:v0 + nv] @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
+        got = visuals[1].vertices @ poses["upper"][1][k].T + poses["upper"][0][k]
+        np.testing.assert_allclose(got, expect, atol=1e-6)
+    scene = scene_of(traj, fps=20)
+    assert sum(s["type"] == "mesh" for s in scene["shapes"]) == 4

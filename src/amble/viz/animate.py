@@ -61,18 +61,18 @@ def floor_under(shapes: Sequence[Any], points: dict[str, np.ndarray], extra: Seq
 
 def with_meshes(traj: Trajectory, times: np.ndarray, shapes: list[Any], max_triangles: int
                 ) -> tuple[list[Any], dict, dict, list[np.ndarray]]:
-    """The default look of a robot read from a URDF with its ``<visual>`` meshes fixed to its
+    """The default look of a robot read from a URDF (or MJCF) with its visual meshes fixed to its
     links (at most ``max_triangles`` triangles together): the balls and sticks of the links that
     have a mesh, and of the massless link frames, are left out. Returns the shapes, the poses and
     meshes for :func:`frames`, and the world corners ``(F, 8, 3)`` of each mesh's bounding box;
     unchanged (no meshes) for a model built in code."""
     from .links import link_poses, robot_file
-    from .meshes import encode, urdf_visuals, within_budget
+    from .meshes import encode, robot_visuals, within_budget
 
     path = robot_file(traj.system)
     if path is None:
         return shapes, {}, {}, []
-    visuals = within_budget(urdf_visuals(path), max_triangles)
+    visuals = within_budget(robot_visuals(path), max_triangles)
     poses = link_poses(traj, times, {v.link for v in visuals})
     poses = {k: (np.nan_to_num(p), np.nan_to_num(R)) for k, (p, R) in poses.items()}
     meshes, drawn, corners = {}, [], []

@@ -32,7 +32,7 @@ def _tree(model: Any) -> RigidTree | None:
 
 
 def robot_file(system: Any) -> Path | None:
-    """The URDF every mode of ``system`` was read from, or ``None`` (a model built in code, a
+    """The robot file (URDF or MJCF) every mode of ``system`` was read from, or ``None`` (a model built in code, a
     constrained or a mixed one)."""
     files = {None if _tree(m) is None else Path(_tree(m).file) for m in system.modes.values()}
     return files.pop() if len(files) == 1 else None
@@ -91,8 +91,8 @@ def _samples(traj: Trajectory, times: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 def link_poses(traj: Trajectory, times: np.ndarray, links: set[str] | None = None) -> Poses:
     """World poses of the robot file's links at ``times`` (s): link → ``(positions (F, 3) m,
-    rotations (F, 3, 3))``, the link frame's axes as columns; ``links``: only these. Empty for a
-    system that was not read from a URDF."""
+    rotations (F, 3, 3))``, the link frame's axes as columns (an MJCF file's bodies are its
+    links); ``links``: only these. Empty for a system that was not read from a robot file."""
     system = traj.system
     if robot_file(system) is None:
         return {}

@@ -31,7 +31,8 @@ import numpy as np
 from .errors import SceneError
 from .shapes import Color
 
-__all__ = ["MAX_TRIANGLES", "Visual", "decimate", "encode", "resolve", "urdf_visuals", "within_budget"]
+__all__ = ["MAX_TRIANGLES", "Visual", "decimate", "encode", "mjcf_visuals", "resolve", "robot_visuals", "urdf_visuals",
+           "within_budget"]
 
 #: Triangles of all the meshes of one scene together (about 12 bytes each in the page).
 MAX_TRIANGLES = 120_000
@@ -165,6 +166,76 @@ def urdf_visuals(path: str | Path) -> list[Visual]:
             color, opacity = _color(visual, named, mesh)
             out.append(Visual(link.name, v, np.asarray(mesh.faces, dtype=np.int64), color, opacity))
     return out
+
+
+def _mjcf_shape(m: Any, g: int) -> Any:
+    """Geom ``g`` of a compiled MuJoCo model as a ``trimesh.Trimesh`` in the geom's frame, or
+    ``None`` (a plane, a height field)."""
+    import mujoco
+    import trimesh
+
+    kind, size = int(m.geom_type[g]), np.asarray(m.geom_size[g], dtype=float)
+    t = mujoco.mjtGeom
+    if kind == t.mjGEOM_MESH:
+        d = int(m.geom_dataid[g])
+        v0, nv, f0, nf = m.mesh_vertadr[d], m.mesh_vertnum[d], m.mesh_faceadr[d], m.mesh_facenum[d]
+        return trimesh.Trimesh(np.asarray(m.mesh_vert[v0:v0 + nv], dtype=float),
+                               np.asarray(m.mesh_face[f0:f0 + nf], dtype=np.int64), process=False)
+    if kind == t.mjGEOM_BOX:
+        return trimesh.creation.box(extents=2 * size)
+    if kind == t.mjGEOM_SPHERE:
+        return trimesh.creation.icosphere(subdivisions=2, radius=size[0])
+    if kind == t.mjGEOM_ELLIPSOID:
+        ball = trimesh.creation.icosphere(subdivisions=2)
+        ball.apply_scale(size)
+        return ball
+    if kind == t.mjGEOM_CYLINDER:        # MuJoCo's size: radius, half-length along z
+        return trimesh.creation.cylinder(radius=size[0], height=2 * size[1], sections=24)
+    if kind == t.mjGEOM_CAPSULE:
+        return trimesh.creation.capsule(height=2 * size[1], radius=size[0], count=[24, 12])
+    return None
+
+
+def mjcf_visuals(path: str | Path) -> list[Visual]:
+    """Every geom of the bodies (not the world's) of the MJCF at ``path`` that MuJoCo's viewer
+    shows by default (groups 0 to 2, not transparent), placed in its body's frame (MuJoCo's
+    ``geom_pos``, ``geom_quat``), coloured by ``geom_rgba`` or its material's ``mat_rgba``.
+
+    Raises:
+        SceneError: MuJoCo's compiler refuses the file.
+    """
+    import mujoco
+
+    path = Path(path)
+    try:
+        m = mujoco.MjModel.from_xml_path(str(path))
+    except Exception as e:
+        raise SceneError(f"MJCF {path.name}: cannot be read for drawing: {e}") from e
+    out = []
+    for g in range(m.ngeom):
+        b = int(m.geom_bodyid[g])
+        rgba = np.asarray(m.mat_rgba[m.geom_matid[g]] if m.geom_matid[g] >= 0 else m.geom_rgba[g], dtype=float)
+        if b == 0 or m.geom_group[g] > 2 or rgba[3] == 0:
+            continue
+        mesh = _mjcf_shape(m, g)
+        if mesh is None or len(mesh.faces) == 0:
+            continue
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, np.asarray(m.geom_quat[g], dtype=float))
+        v = np.asarray(mesh.vertices, dtype=float) @ R.reshape(3, 3).T + m.geom_pos[g]
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or f"body{b}"
+        rgb = np.clip(rgba[:3], 0.0, 1.0)
+        out.append(Visual(name, v, np.asarray(mesh.faces, dtype=np.int64),
+                          (float(rgb[0]), float(rgb[1]), float(rgb[2])), float(np.clip(rgba[3], 0, 1))))
+    return out
+
+
+def robot_visuals(path: str | Path) -> list[Visual]:
+    """The visuals of a robot file: :func:`mjcf_visuals` for ``.xml`` / ``.mjcf``, else
+    :func:`urdf_visuals`."""
+    if Path(path).suffix.lower() in (".xml", ".mjcf"):
+        return mjcf_visuals(path)
+    return urdf_visuals(path)
 
 
 def _cluster(v: np.ndarray, f: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
