@@ -271,3 +271,23 @@ def test_mjcf_geoms_and_body_poses_match_mujoco(tmp_path):
         np.testing.assert_allclose(got, expect, atol=1e-6)
     scene = scene_of(traj, fps=20)
     assert sum(s["type"] == "mesh" for s in scene["shapes"]) == 4
+
+
+@pytest.mark.slow
+def test_link_poses_of_a_rerooted_robot_match_yourdfpy():
+    """Bolt fixed at its left shank: the joints up to the URDF root are traversed backwards."""
+    system = load_robot(BOLT, base="FL_LOWER_LEG", fixed_base=True)
+    x0 = np.zeros(12)
+    x0[:6] = [0.3, -0.2, 0.5, 0.1, 0.4, -0.6]
+    traj = simulate(system, x0, t_end=0.2)
+    times = np.array([0.0, 0.1, 0.2])
+    poses = link_poses(traj, times)
+    urdf = yourdfpy.URDF.load(str(BOLT), load_meshes=False)
+    q_names = [str(q) for q in system.modes[traj.mode_names[0]].q]
+    for k, t in enumerate(times):
+        i = int(np.argmin(np.abs(traj.t - t)))
+        urdf.update_cfg({n: float(traj.x[i, j]) for j, n in enumerate(q_names)})
+        for link in urdf.link_map:
+            T = urdf.get_transform(link, "FL_LOWER_LEG")
+            np.testing.assert_allclose(poses[link][0][k], T[:3, 3], atol=1e-12)
+            np.testing.assert_allclose(poses[link][1][k], T[:3, :3], atol=1e-12)

@@ -74,6 +74,8 @@ def with_meshes(traj: Trajectory, times: np.ndarray, shapes: list[Any], max_tria
         return shapes, {}, {}, []
     visuals = within_budget(robot_visuals(path), max_triangles)
     poses = link_poses(traj, times, {v.link for v in visuals})
+    if any(np.any(np.linalg.det(np.nan_to_num(R)) < 0) for _, R in poses.values()):
+        return shapes, {}, {}, []   # a walker whose frame change mirrors it: a mesh cannot be turned so
     poses = {k: (np.nan_to_num(p), np.nan_to_num(R)) for k, (p, R) in poses.items()}
     meshes, drawn, corners = {}, [], []
     for k, v in enumerate(visuals):
