@@ -291,3 +291,15 @@ def test_link_poses_of_a_rerooted_robot_match_yourdfpy():
             T = urdf.get_transform(link, "FL_LOWER_LEG")
             np.testing.assert_allclose(poses[link][0][k], T[:3, 3], atol=1e-12)
             np.testing.assert_allclose(poses[link][1][k], T[:3, :3], atol=1e-12)
+
+
+@pytest.mark.slow
+def test_talos_meshes_fit_the_budget():
+    """Talos (about 159 000 triangles) reduced to the default budget: a page of a few MB."""
+    visuals = urdf_visuals(ROBOTS / "talos_data" / "robots" / "talos_reduced.urdf")
+    assert sum(len(v.faces) for v in visuals) > 150_000
+    small = within_budget(visuals)
+    assert sum(len(v.faces) for v in small) <= 120_000 + 48 * len(visuals)
+    size = sum(len(encode(v.vertices, v.faces)["positions"]) + len(encode(v.vertices, v.faces)["indices"])
+               for v in small)
+    assert size < 2_000_000
