@@ -23,9 +23,11 @@ from test_html import HEIGHT, WIDTH, _chromium, _finish, _read_png, needs_chromi
 from amble import simulate  # noqa: E402
 from amble.models import load_robot  # noqa: E402
 from amble.viz.animate import scene_of  # noqa: E402
+from amble.viz.errors import SceneError  # noqa: E402
 from amble.viz.html import render_html, write_html  # noqa: E402
 from amble.viz.links import link_poses  # noqa: E402
 from amble.viz.meshes import decimate, decode, encode, urdf_visuals, within_budget  # noqa: E402
+from amble.viz.scene import Mesh, frames  # noqa: E402
 
 
 def _robots() -> Path:
@@ -141,6 +143,24 @@ def test_encoding_round_trips_to_a_fraction_of_the_quantum():
     assert np.all(np.abs(v - sphere.vertices) <= step / 2 + 1e-15)
     np.testing.assert_array_equal(f, sphere.faces)
     assert not enc["wide"] and enc["triangles"] == len(sphere.faces)
+
+
+def test_a_mesh_needs_its_frame_and_its_triangles():
+    t = np.array([0.0, 0.1])
+    box = trimesh.creation.box(extents=(0.1, 0.2, 0.3))
+    meshes = {"m": encode(box.vertices, box.faces)}
+    still = (np.array([[0.0, 0.0, 1.0]] * 2), np.stack([np.eye(3)] * 2))
+    with pytest.raises(SceneError, match="unknown frame 'arm'"):
+        frames([Mesh("arm", "m")], {}, t, poses={}, meshes=meshes)
+    with pytest.raises(SceneError, match="unknown mesh 'n'"):
+        frames([Mesh("arm", "n")], {}, t, poses={"arm": still}, meshes=meshes)
+    with pytest.raises(SceneError, match="shapes"):
+        frames([Mesh("arm", "m")], {}, t, poses={"arm": (still[0][:1], still[1])}, meshes=meshes)
+    scene = frames([Mesh("arm", "m")], {}, t, poses={"arm": still}, meshes=meshes)
+    assert scene["poses"]["arm"] == [0, 0, 1, 0, 0, 0, 1] * 2          # x, y, z, then (x, y, z, w)
+    # the bounds are the box's, where the pose puts it
+    assert scene["bounds"] == {"min": [-0.05, -0.1, 0.85], "max": [0.05, 0.1, 1.15]}
+    assert scene["size"] == pytest.approx(np.linalg.norm([0.1, 0.2, 0.3]), abs=1e-5)
 
 
 @pytest.fixture(scope="module")
