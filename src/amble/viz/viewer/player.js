@@ -112,7 +112,8 @@
 
   // ---- subtitle -------------------------------------------------------------------
   const sub = [];
-  if (ground) sub.push('slope ' + (ground.slope * 180 / Math.PI).toFixed(2) + '°');
+  // a level floor (under a robot that is no walker) has no slope to tell
+  if (ground && ground.slope !== 0) sub.push('slope ' + (ground.slope * 180 / Math.PI).toFixed(2) + '°');
   sub.push(F + ' frames');
   $('subtitle').textContent = sub.join(' · ');
 
