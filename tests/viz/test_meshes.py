@@ -323,3 +323,47 @@ def test_talos_meshes_fit_the_budget():
     size = sum(len(encode(v.vertices, v.faces)["positions"]) + len(encode(v.vertices, v.faces)["indices"])
                for v in small)
     assert size < 2_000_000
+
+
+def test_a_floating_robots_links_and_massless_frames_are_posed(tmp_path):
+    """A floating two-link robot with a massless camera on a fixed joint (merged into its body):
+    every link's pose is the base pose of the documented convention — translation, then
+    ``Rz(yaw) Ry(pitch) Rx(roll)`` — composed with yourdfpy's kinematics from the base."""
+    inertia = '<inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/>'
+    text = f"""<robot name="cam">
+  <link name="torso"><inertial><mass value="2"/>{inertia}</inertial>
+    <visual><geometry><box size="0.2 0.1 0.3"/></geometry></visual></link>
+  <link name="arm"><inertial><origin xyz="0 0 -0.1"/><mass value="1"/>{inertia}</inertial>
+    <visual><origin xyz="0 0 -0.1"/><geometry><cylinder radius="0.02" length="0.2"/></geometry></visual></link>
+  <link name="camera"><visual><geometry><box size="0.03 0.03 0.03"/></geometry></visual></link>
+  <joint name="shoulder" type="revolute"><parent link="torso"/><child link="arm"/>
+    <origin xyz="0 0.1 0.1" rpy="0.2 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="mount" type="fixed"><parent link="arm"/><child link="camera"/>
+    <origin xyz="0.02 0 -0.2" rpy="0.1 0.5 -0.3"/></joint>
+</robot>"""
+    path = tmp_path / "cam.urdf"
+    path.write_text(text)
+    system = load_robot(path)
+    names = [str(q) for q in system.modes[system.name].q]
+    x0 = np.zeros(2 * len(names))
+    x0[: len(names)] = [0.1, -0.2, 0.3, 0.4, -0.3, 0.2, 0.7]
+    x0[len(names):] = [0.2, 0.1, 0.0, 0.5, -0.4, 0.3, 1.0]
+    traj = simulate(system, x0, t_end=0.2)
+    times = np.array([0.0, 0.1, 0.2])
+    poses = link_poses(traj, times)
+    assert set(poses) == {"torso", "arm", "camera"}
+    urdf = yourdfpy.URDF.load(str(path), load_meshes=False)
+    for k, t in enumerate(times):
+        i = int(np.argmin(np.abs(traj.t - t)))
+        q = dict(zip(names, traj.x[i, : len(names)]))
+        Rb = _rpy(q["base_roll"], q["base_pitch"], q["base_yaw"])
+        pb = np.array([q["base_x"], q["base_y"], q["base_z"]])
+        urdf.update_cfg({"shoulder": float(q["shoulder"])})
+        for link in ("torso", "arm", "camera"):
+            T = urdf.get_transform(link, "torso")
+            np.testing.assert_allclose(poses[link][0][k], pb + Rb @ T[:3, 3], atol=1e-12)
+            np.testing.assert_allclose(poses[link][1][k], Rb @ T[:3, :3], atol=1e-12)
+    scene = scene_of(traj, fps=20)
+    assert sorted(s["frame"] for s in scene["shapes"] if s["type"] == "mesh") == ["arm", "camera", "torso"]
+    assert not any(s["type"] in ("sphere", "cylinder") for s in scene["shapes"])

@@ -113,7 +113,8 @@ def link_poses(traj: Trajectory, times: np.ndarray, links: set[str] | None = Non
         q = {n: x[:, names.index(n)] for n in (str(s) for s in model.q)}
         subs = {s: traj.parameters.get(str(s), v) for s, v in model.params.items()}
         bodies = _bodies(tree, q, len(rows), subs)
-        frames = {lk: bodies[lk] for lk in bodies if links is None or lk in links}
+        # the bodies that are links (a composite joint's inner frames are not)
+        frames = {lk: bodies[lk] for lk in bodies if lk in tree.com_points and (links is None or lk in links)}
         for lk, (body, Rl, origin) in tree.link_frames.items():
             if (links is None or lk in links) and (body is None or body in bodies):
                 R, p = bodies[body] if body is not None else (np.eye(3)[None], np.zeros((1, 3)))
