@@ -282,6 +282,7 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
             parent = frame
         names[b] = bname
     tree.joint_damping(ctx["damping"])
+    tree.file = path
     for pname, spec in (contact_points or {}).items():
         try:
             body, at = spec

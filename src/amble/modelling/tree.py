@@ -173,6 +173,11 @@ class RigidTree:
         #: the body of each named point and its offset from the body origin (world axes, named)
         self.point_frames: dict[str, tuple[Body, sp.Matrix]] = {}
         self.limits: dict[str, tuple[float | None, float | None]] = {}
+        #: the robot file the tree was read from (None when built in code), for drawing its meshes
+        self.file: Any = None
+        #: links of the file that are no body (massless, on a fixed joint): link → (body it is
+        #: fixed to (None: the world), rotation of the link frame in the body's, origin in it, m)
+        self.link_frames: dict[str, tuple[str, np.ndarray, tuple]] = {}
         #: intermediate quantities of the recursions (body kinematics here, dynamics in derivation)
         self.defs = Defs()
         self._energies: dict[tuple, sp.Expr] = {}

@@ -468,6 +468,10 @@ def build_model(cls: type, path: Any, base: str | None = None, contact_points: M
         tree.body(lk, parent=parent, joint=joint, mass=mass, com=com, inertia=inertia,
                   coordinate=j.name)
     _joint_dynamics(tree, order, path, len(root.findall("transmission")))
+    tree.file = path
+    tree.link_frames = dict(frames)
+    if base_joint is None:   # the base link is the world frame
+        tree.link_frames[base] = (None, np.eye(3), (0.0, 0.0, 0.0))
     for pname, spec in (contact_points or {}).items():
         try:
             lk, at = spec

@@ -182,10 +182,18 @@ class Trajectory:
         swap sides reflects the lateral axis)."""
         if self._world is None:
             pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
-            origins, frames = self._frames_per_row(pos)
+            origins, frames = self.world_frames(pos)
             world = np.einsum("rij,rpj->rpi", frames, pos) + origins[:, None, :]
             self._world = {n: world[:, i, :] for i, n in enumerate(self.kernels.meta["points"])}
         return self._world
+
+    def world_frames(self, pos: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Per row, the origin ``(N, 3)`` (m) and axes ``(N, 3, 3)`` of the row's model frame in
+        the world: ``world = axes @ model + origin`` (see :meth:`world_points`); ``pos``: the
+        rows' point positions, if already computed."""
+        if pos is None:
+            pos, _ = self.kernels.kinematics_rows(self.t, self.mode, self.x, self.params)
+        return self._frames_per_row(pos)
 
     def _frames_per_row(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         meta = self.kernels.meta

@@ -13,7 +13,7 @@ from ..modelling.hybrid import HybridSystem
 from ..modelling.walker import Walker
 from ..simulation.trajectory import Trajectory
 from .errors import SceneError, VizError
-from .scene import Ground, Shape, Sphere, default_look, frames
+from .scene import Cylinder, Ground, Mesh, Shape, Sphere, default_look, frames
 
 
 def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] | None = None) -> list[Any]:
@@ -46,14 +46,56 @@ def look_of(system: HybridSystem, params: dict[str, float], look: Sequence[Any] 
     return out
 
 
-def floor_under(shapes: Sequence[Any], points: dict[str, np.ndarray]) -> Ground:
+def floor_under(shapes: Sequence[Any], points: dict[str, np.ndarray], extra: Sequence[np.ndarray] = ()) -> Ground:
     """A level floor for a robot that declares no ground (a fixed-base arm, a falling robot): at
     the lowest point the drawing reaches over the run — the lowest point less the radius of its
-    sphere, if it has one — and wide enough for the robot's lateral reach (m)."""
+    sphere, if it has one, or the lowest of the ``extra`` positions ``(F, 3)`` (the corners of
+    its meshes) — and wide enough for the robot's lateral reach (m)."""
     radius = {s.at: s.radius for s in shapes if isinstance(s, Sphere)}
-    low = min(float(np.min(v[:, 2])) - radius.get(n, 0.0) for n, v in points.items())
-    reach = max(float(np.max(np.abs(v[:, 1]))) + radius.get(n, 0.0) for n, v in points.items())
+    low = min([float(np.min(v[:, 2])) - radius.get(n, 0.0) for n, v in points.items()]
+              + [float(np.min(v[..., 2])) for v in extra])
+    reach = max([float(np.max(np.abs(v[:, 1]))) + radius.get(n, 0.0) for n, v in points.items()]
+                + [float(np.max(np.abs(v[..., 1]))) for v in extra])
     return Ground(slope=0.0, height=low, width=max(2.0, 2.0 * reach + 1.0))
+
+
+def with_meshes(traj: Trajectory, times: np.ndarray, shapes: list[Any], max_triangles: int
+                ) -> tuple[list[Any], dict, dict, list[np.ndarray]]:
+    """The default look of a robot read from a URDF (or MJCF) with its visual meshes fixed to its
+    links (at most ``max_triangles`` triangles together): the balls and sticks of the links that
+    have a mesh, and of the massless link frames, are left out. Returns the shapes, the poses and
+    meshes for :func:`frames`, and the world corners ``(F, 8, 3)`` of each mesh's bounding box;
+    unchanged (no meshes) for a model built in code."""
+    from .links import link_poses, robot_file
+    from .meshes import encode, robot_visuals, within_budget
+
+    path = robot_file(traj.system)
+    if path is None:
+        return shapes, {}, {}, []
+    visuals = within_budget(robot_visuals(path), max_triangles)
+    poses = link_poses(traj, times, {v.link for v in visuals})
+    if any(np.any(np.linalg.det(np.nan_to_num(R)) < 0) for _, R in poses.values()):
+        return shapes, {}, {}, []   # a walker whose frame change mirrors it: a mesh cannot be turned so
+    poses = {k: (np.nan_to_num(p), np.nan_to_num(R)) for k, (p, R) in poses.items()}
+    meshes, drawn, corners = {}, [], []
+    for k, v in enumerate(visuals):
+        if v.link not in poses:
+            continue
+        key = f"{v.link}#{k}"
+        meshes[key] = encode(v.vertices, v.faces)
+        drawn.append(Mesh(frame=v.link, mesh=key, color=v.color, opacity=v.opacity))
+        lo, hi = v.vertices.min(axis=0), v.vertices.max(axis=0)
+        box = np.array([[(hi if (i >> a) & 1 else lo)[a] for a in range(3)] for i in range(8)])
+        p, R = poses[v.link]
+        corners.append(p[:, None, :] + box @ np.swapaxes(R, 1, 2))
+    if not drawn:
+        return shapes, {}, {}, []
+    tree = next(iter(traj.system.modes.values())).tree
+    covered = {m.frame for m in drawn} | set(tree.link_frames)
+    kept = [s for s in shapes
+            if not (isinstance(s, Sphere) and s.at in covered)
+            and not (isinstance(s, Cylinder) and set(s.between) & covered)]
+    return [*kept, *drawn], poses, meshes, corners
 
 
 def _slope(system: HybridSystem, params: dict[str, float]) -> float:
@@ -80,27 +122,39 @@ def series_of(traj: Trajectory, times: np.ndarray, names: Sequence[str] | None) 
 
 
 def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = None,
-             series: Sequence[str] | None = None) -> dict:
+             series: Sequence[str] | None = None, max_triangles: int | None = None) -> dict:
     """Scene JSON (see :func:`amble.viz.scene.frames`) of a trajectory in world coordinates, with
-    a time-series panel of ``series`` (see :func:`series_of`; ``[]`` for none)."""
+    a time-series panel of ``series`` (see :func:`series_of`; ``[]`` for none). Without a
+    ``look``, a robot read from a URDF is drawn with its visual meshes, at most ``max_triangles``
+    triangles (default :data:`amble.viz.meshes.MAX_TRIANGLES`; 0 draws balls and sticks)."""
+    from .meshes import MAX_TRIANGLES
+
     system = traj.system
     times, pts = traj.resample(fps)
     shapes = look_of(system, traj.parameters, look)
+    poses: dict = {}
+    meshes: dict = {}
+    corners: list[np.ndarray] = []
+    budget = MAX_TRIANGLES if max_triangles is None else int(max_triangles)
+    if not look and budget > 0:
+        shapes, poses, meshes, corners = with_meshes(traj, times, shapes, budget)
     walker = isinstance(system, Walker)
     hip = system.hip if walker else None
     follow = hip if hip in pts else None
     used = {n for s in shapes for n in s.points()}
     pts = {n: np.nan_to_num(v) for n, v in pts.items() if n in used or n == follow}
-    if not any(isinstance(s, Ground) for s in shapes) and pts:
-        shapes = [floor_under(shapes, pts), *shapes]
+    if not any(isinstance(s, Ground) for s in shapes) and (pts or corners):
+        shapes = [floor_under(shapes, pts, corners), *shapes]
     labels = {}
     if walker:  # a step count means something for a walker only
         labels["step"] = np.searchsorted([e.t for e in traj.step_events], times, side="right").tolist()
-    return frames(shapes, pts, times, follow=follow, labels=labels, series=series_of(traj, times, series))
+    return frames(shapes, pts, times, follow=follow, labels=labels, series=series_of(traj, times, series),
+                  poses=poses, meshes=meshes)
 
 
 def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None,
-            progress: bool | None = None, series: Sequence[str] | None = None) -> Path:
+            progress: bool | None = None, series: Sequence[str] | None = None,
+            max_triangles: int | None = None) -> Path:
     """Write an animation of ``traj``: ``.html`` (3D, offline, interactive), ``.gif`` or ``.mp4``.
 
     ``look``: the shapes to draw (:mod:`amble.viz.scene`); default: made from the model. A movie
@@ -108,13 +162,15 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
     whole hundredths of a second: 25 fps for 30); ``progress``: a progress bar while a movie is
     written (default: when stderr is a terminal). See :mod:`amble.viz.movie`. ``series``: state
     variables (and ``"energy"``) shown as time series under the 3D view of the ``.html`` viewer,
-    with a playhead (default: the coordinates and the energy; ``[]`` for no panel)."""
+    with a playhead (default: the coordinates and the energy; ``[]`` for no panel). A robot read
+    from a URDF is drawn in the ``.html`` viewer with its visual meshes, at most ``max_triangles``
+    triangles together (default :data:`amble.viz.meshes.MAX_TRIANGLES`; 0: balls and sticks)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".html":
         from .html import write_html
 
-        return write_html(path, scene_of(traj, fps, look, series), title=f"amble — {traj.system.name}")
+        return write_html(path, scene_of(traj, fps, look, series, max_triangles), title=f"amble — {traj.system.name}")
     if suffix in (".gif", ".mp4"):
         from .movie import check_writer, write_movie
 

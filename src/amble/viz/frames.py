@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .errors import SceneError
-from .shapes import DIGITS, Box, Ground, Shape, check_name, rounded
+from .shapes import DIGITS, Box, Ground, Mesh, Shape, check_name, rounded
 
 __all__ = ["FORMAT", "frames"]
 
@@ -25,6 +25,8 @@ def frames(
     follow: str | None = None,
     labels: Mapping[str, Sequence[Any]] | None = None,
     series: Mapping[str, Sequence[float]] | None = None,
+    poses: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    meshes: Mapping[str, dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """Build the JSON-serialisable scene the viewer animates.
 
@@ -40,6 +42,10 @@ def frames(
             ``{"step": step_index}``; each a sequence of ``F`` numbers or strings.
         series: time series drawn in the viewer's panel with a playhead, e.g.
             ``{"stance": values, "energy": values}``; each ``F`` numbers.
+        poses: frames that :class:`Mesh` shapes are fixed to, by name: positions ``(F, 3)`` in
+            metres and rotations ``(F, 3, 3)`` (the frame's axes as columns, world coordinates).
+        meshes: triangles of the :class:`Mesh` shapes by key, as :func:`amble.viz.meshes.encode`
+            writes them.
 
     Returns:
         The scene dictionary described in :mod:`amble.viz.scene`.
@@ -79,14 +85,16 @@ def frames(
         )
 
     arrays = {name: _as_xyz(name, points[name], n) for name in needed}
+    pose_data, corners = _mesh_parts(shapes, poses or {}, meshes or {}, n)
+    extent = [*arrays.values(), *corners]
 
     size = 0.0
-    if arrays:
-        stacked = np.concatenate(list(arrays.values()), axis=0)
+    if extent:
+        stacked = np.concatenate(extent, axis=0)
         lo, hi = stacked.min(axis=0), stacked.max(axis=0)
         # the robot's own size: the largest diagonal of its bounding box in any one frame (the
         # camera's distance; the bounds of the whole run are the walk's, not the robot's)
-        per_frame = np.stack(list(arrays.values()), axis=0)  # (points, frames, 3)
+        per_frame = np.stack(extent, axis=0)  # (points, frames, 3)
         size = float(np.max(np.linalg.norm(per_frame.max(axis=0) - per_frame.min(axis=0), axis=1)))
     else:
         static = [s.center for s in shapes if isinstance(s, Box)]
@@ -108,10 +116,47 @@ def frames(
         "follow": follow,
         "labels": _labels(labels, n),
         **({"series": _series(series, n)} if series else {}),
+        **pose_data,
         "bounds": {"min": _flat(lo), "max": _flat(hi)},
         "size": rounded(size),
     }
     return scene
+
+
+def _mesh_parts(shapes: Sequence[Shape], poses: Mapping[str, tuple[np.ndarray, np.ndarray]],
+                meshes: Mapping[str, dict[str, Any]], n: int) -> tuple[dict[str, Any], list[np.ndarray]]:
+    """The scene's ``poses`` (``[x, y, z, qx, qy, qz, qw]`` per frame, the rotation as a unit
+    quaternion) and ``meshes`` used by :class:`Mesh` shapes, and the world positions ``(F, 3)`` of
+    the corners of each mesh's bounding box (for the bounds and the robot's size)."""
+    from scipy.spatial.transform import Rotation
+
+    used = [s for s in shapes if isinstance(s, Mesh)]
+    if not used:
+        return {}, []
+    out_poses: dict[str, list[float]] = {}
+    corners: list[np.ndarray] = []
+    for s in used:
+        if s.frame not in poses:
+            raise SceneError(f"frames: mesh on unknown frame {s.frame!r}; "
+                             f"poses given: {', '.join(map(repr, poses)) or 'none'}")
+        if s.mesh not in meshes:
+            raise SceneError(f"frames: unknown mesh {s.mesh!r}")
+        p, R = (np.asarray(a, dtype=float) for a in poses[s.frame])
+        if p.shape != (n, 3) or R.shape != (n, 3, 3):
+            raise SceneError(f"frames: pose {s.frame!r} must have shapes ({n}, 3) and ({n}, 3, 3), "
+                             f"got {p.shape} and {R.shape}")
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(R))):
+            raise SceneError(f"frames: pose {s.frame!r} has non-finite values")
+        if s.frame not in out_poses:
+            q = Rotation.from_matrix(R).as_quat()   # (x, y, z, w), as three.js stores it
+            out_poses[s.frame] = _flat(np.column_stack([p, q]))
+        m = meshes[s.mesh]
+        lo = np.asarray(m["lo"], dtype=float)
+        hi = lo + 65535 * np.asarray(m["step"], dtype=float)
+        box = np.array([[(hi if (k >> a) & 1 else lo)[a] for a in range(3)] for k in range(8)])
+        corners.extend(np.swapaxes(p[:, None, :] + box @ np.swapaxes(R, 1, 2), 0, 1))
+    keys = dict.fromkeys(s.mesh for s in used)
+    return {"poses": out_poses, "meshes": {k: dict(meshes[k]) for k in keys}}, corners
 
 
 def _as_xyz(name: str, value: np.ndarray, n: int) -> np.ndarray:

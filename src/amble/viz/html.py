@@ -22,7 +22,8 @@ Keyboard: space plays/pauses, left/right arrows step one frame.
 The page's parts are package data in ``viewer/``: ``viewer.html`` (the template, with
 ``@TITLE@``, ``@CSS@``, ``@SCENE@``, ``@THREE@`` and ``@VIEWER@`` placeholders),
 ``viewer.css``, and the script in three parts of one function body: ``data.js`` (status,
-scene data, URL hash, frame lookup), ``scene.js`` (three.js objects and camera) and
+scene data, URL hash, frame lookup), ``scene.js`` (three.js objects and camera),
+``meshes.js`` (triangle meshes on link frames), ``series.js`` (the time-series panel) and
 ``player.js`` (time, controls, ``window.amble``, the loop).
 """
 
@@ -42,7 +43,7 @@ from .scene import FORMAT
 __all__ = ["render_html", "write_html"]
 
 #: The viewer's parts of one function body, joined in this order (see viewer/data.js).
-_VIEWER_PARTS = ("data.js", "scene.js", "series.js", "player.js")
+_VIEWER_PARTS = ("data.js", "scene.js", "meshes.js", "series.js", "player.js")
 
 
 def _read(*path: str) -> str:

@@ -20,17 +20,20 @@ _CYCLE = ("amble.analysis.poincare", "LimitCycle")
 #: Frames of the inline viewer at most: a long run is shown at a lower frame rate, so that a
 #: display stays near the size of the viewer's own library (≈ 0.8 MB), however long the run.
 MAX_FRAMES = 900
+#: Triangles of a robot file's meshes in the inline viewer at most (about 0.5 MB of the display).
+MAX_TRIANGLES = 40_000
 
 
 def trajectory_html(traj: Any, height: int = 480, max_frames: int = MAX_FRAMES) -> str:
     """The 3D viewer of a trajectory as an ``<iframe>`` for a notebook cell (30 fps, fewer for a
-    run longer than ``max_frames`` / 30 time units)."""
+    run longer than ``max_frames`` / 30 time units; a robot file's meshes reduced to
+    :data:`MAX_TRIANGLES`)."""
     from .animate import scene_of
     from .html import render_html
 
     duration = float(traj.t[-1] - traj.t[0]) if len(traj.t) else 0.0
     fps = min(30.0, max_frames / duration) if duration > 0 else 30.0
-    page = render_html(scene_of(traj, fps=fps), title=f"amble — {traj.system.name}")
+    page = render_html(scene_of(traj, fps=fps, max_triangles=MAX_TRIANGLES), title=f"amble — {traj.system.name}")
     return (f'<iframe srcdoc="{_html.escape(page)}" style="width:100%;height:{height}px;border:0" '
             'sandbox="allow-scripts"></iframe>')
 

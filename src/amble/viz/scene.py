@@ -27,14 +27,24 @@ Scene format (``"format": "amble.scene/1"``)
         {"type": "box",      "center": "hip" | [x, y, z], "size": [sx, sy, sz],
                              "rotation": [rx, ry, rz], "color": ..., "opacity": a},
         {"type": "ground",   "slope": s, "width": w, "grid": g, "extent": [s0, s1],
-                             "color": ..., "opacity": a, "height": z0}   # height: if not 0
+                             "color": ..., "opacity": a, "height": z0},  # height: if not 0
+        {"type": "mesh",     "frame": "thigh", "mesh": "thigh#0", "color": ..., "opacity": a}
       ],
+      "poses":  {"thigh": [x0, y0, z0, qx0, qy0, qz0, qw0, x1, ...]},  # 7*F floats per frame
+                                                # (metres; the rotation as a unit quaternion)
+      "meshes": {"thigh#0": {"positions": b64, "indices": b64, "wide": false,
+                             "lo": [x, y, z], "step": [dx, dy, dz], "triangles": n}},
       "follow": "hip" | null,                   # point the camera may track
       "labels": {"step": [0, 0, 1, ...]},        # F values per label (numbers or strings)
       "bounds": {"min": [x, y, z], "max": [x, y, z]}, # over all exported points and frames
       "size": d                                 # the robot's extent: largest bounding-box
                                                 # diagonal of one frame, metres
     }
+
+``poses`` and ``meshes`` are present when a shape is a mesh: a vertex is ``lo + k * step`` per
+axis for the little-endian uint16 triples ``k`` of ``positions``, ``indices`` holds uint16 (uint32
+when ``wide``) triangles, both base64 (see :mod:`amble.viz.meshes`); the bounds and ``size``
+include the meshes' bounding boxes.
 
 Only points referenced by a shape (or by ``follow``) are exported. Numbers are
 rounded to 1e-5, which is far below what a screen can show and keeps a 20 s,
@@ -48,7 +58,7 @@ from collections.abc import Mapping, Sequence
 
 from .errors import SceneError
 from .frames import FORMAT, frames
-from .shapes import PALETTE, Box, Color, Cylinder, Ground, Shape, Sphere
+from .shapes import PALETTE, Box, Color, Cylinder, Ground, Mesh, Shape, Sphere
 
 __all__ = [
     "FORMAT",
@@ -56,6 +66,7 @@ __all__ = [
     "Color",
     "Cylinder",
     "Ground",
+    "Mesh",
     "Shape",
     "Sphere",
     "default_look",

@@ -1,4 +1,5 @@
-"""The shapes of a scene: :class:`Sphere`, :class:`Cylinder`, :class:`Box` and :class:`Ground`.
+"""The shapes of a scene: :class:`Sphere`, :class:`Cylinder`, :class:`Box`, :class:`Ground` and
+:class:`Mesh`.
 
 Each shape is a frozen dataclass whose fields declare their own check (see :func:`_field`):
 :class:`_Shape` runs the checks, lists the point names a shape needs (:meth:`_Shape.points`)
@@ -15,7 +16,7 @@ from typing import Any, ClassVar
 
 from .errors import SceneError
 
-__all__ = ["Box", "Color", "Cylinder", "Ground", "Shape", "Sphere"]
+__all__ = ["Box", "Color", "Cylinder", "Ground", "Mesh", "Shape", "Sphere"]
 
 #: An sRGB colour, three floats in 0..1.
 Color = tuple[float, float, float]
@@ -261,5 +262,27 @@ class Ground(_Shape):
         return out
 
 
+@dataclass(frozen=True)
+class Mesh(_Shape):
+    """Triangles carried by a named frame (a robot link), e.g. a URDF ``<visual>`` mesh.
+
+    The triangles are stored once in the scene's ``meshes`` (see :func:`amble.viz.meshes.encode`)
+    and the frame's pose per frame in its ``poses``; both are given to
+    :func:`amble.viz.scene.frames`.
+
+    Attributes:
+        frame: name of the pose (link frame) the triangles are fixed to.
+        mesh: key of the triangles in the scene's meshes, vertices in the frame's axes, metres.
+        color: sRGB colour, floats in 0..1.
+        opacity: 1 is opaque, 0 is invisible.
+    """
+
+    kind: ClassVar[str] = "mesh"
+    frame: str = _field(check_name)
+    mesh: str = _field(check_name)
+    color: Color = _field(_color, LINK_GREY)
+    opacity: float = _field(_opacity, 1.0)
+
+
 #: Anything :func:`amble.viz.scene.frames` can draw.
-Shape = Sphere | Cylinder | Box | Ground
+Shape = Sphere | Cylinder | Box | Ground | Mesh

@@ -112,6 +112,7 @@
 
   // ---- subtitle -------------------------------------------------------------------
   const sub = [];
+  // a level floor (under a robot that is no walker) has no slope to tell
   if (ground && ground.slope) sub.push('slope ' + (ground.slope * 180 / Math.PI).toFixed(2) + '°');
   sub.push(F + ' frames');
   $('subtitle').textContent = sub.join(' · ');
