@@ -38,6 +38,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..errors import ModelError, ParameterError
+from ..modelling.walker import Walker
 from .defaults import MUJOCO_CONTACT_TIME as CONTACT_TIME
 from .defaults import MUJOCO_TIMESTEP as TIMESTEP
 
@@ -61,6 +62,12 @@ def _mujoco() -> Any:
     return mujoco
 
 
+def _ground_slope(system: Any, values: Mapping[str, float]) -> float:
+    """The walker's ground slope (rad) at ``values``; 0 for a system that is no walker."""
+    declared = system.symbolic()
+    return declared.slope_value(values) if isinstance(declared, Walker) else 0.0
+
+
 def _values(system: Any, params: Mapping[str, float] | None) -> dict[str, float]:
     """The system's parameter values with ``params`` applied; refuses a model of another layout."""
     declared = dict(system.parameters)
@@ -75,8 +82,8 @@ def _values(system: Any, params: Mapping[str, float] | None) -> dict[str, float]
     if unknown:
         raise ParameterError(f"unknown parameter {unknown[0]!r} of model {system.name!r}")
     declared.update({k: float(v) for k, v in (params or {}).items()})
-    if declared.get("slope", 0.0) != 0.0:
-        raise ParameterError("the MuJoCo export stands the robot on level ground: slope must be 0")
+    if _ground_slope(system, declared) != 0.0:
+        raise ParameterError("the MuJoCo export stands the robot on level ground: the walker's slope must be 0")
     return declared
 
 

@@ -47,7 +47,7 @@ class GaitSensitivity:
                 "gsn_coordinates": self.coordinates, "steps": self.steps, "fixed_point": self.fixed_point}
 
 
-def gait_sensitivity(cycle: LimitCycle, parameter: str = "slope") -> GaitSensitivity:
+def gait_sensitivity(cycle: LimitCycle, parameter: str) -> GaitSensitivity:
     """The gait sensitivity norms of ``cycle`` for a one-step disturbance of ``parameter``."""
     system = cycle.hybrid_system
     if system is None:
@@ -61,7 +61,7 @@ def gait_sensitivity(cycle: LimitCycle, parameter: str = "slope") -> GaitSensiti
     if parameter not in names:
         raise StateError(f"unknown parameter {parameter!r}; parameters: {', '.join(names)}")
     j = names.index(parameter)
-    _, _, s = P.derivatives(cycle.fixed_point)
+    _, _, s = P.derivatives(cycle.fixed_point, params=True)
     A, dT = s.dx_dx0, s.dt_dx0
     dx = s.dx_dp[:, j].copy()
     sum_x = np.zeros_like(dx)

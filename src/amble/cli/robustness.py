@@ -15,8 +15,8 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
                model_arg: Callable[[argparse.ArgumentParser], None]) -> None:
     r = add("robustness", "gait sensitivity norm for a disturbance of one step (exact return-map derivatives)")
     model_arg(r)
-    r.add_argument("--param", default="slope", metavar="NAME",
-                   help="the parameter disturbed for one step, e.g. slope (the ramp of one step; default slope)")
+    r.add_argument("--param", required=True, metavar="NAME",
+                   help="the parameter disturbed for one step, e.g. slope (the ramp of one step)")
     r.set_defaults(func=cmd_robustness)
 
 
