@@ -85,14 +85,16 @@ def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any,
 
         # an interrupted or failed sweep cancels its running tasks: distributed then logs a warning
         # and a traceback per task; amble says what happened in one line of its own
-        quiet = logging.getLogger("distributed")
-        level = quiet.level
-        quiet.setLevel(logging.CRITICAL)
+        quiet = [logging.getLogger(name) for name in ("distributed", "tornado.application")]
+        levels = [log.level for log in quiet]
+        for log in quiet:
+            log.setLevel(logging.CRITICAL)
         try:
             client.close()
             cluster.close()
         finally:
-            quiet.setLevel(level)
+            for log, level in zip(quiet, levels):
+                log.setLevel(level)
 
     return client, close
 
@@ -234,15 +236,30 @@ def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, p
                 store.append(rows)
                 bar.update(len(rows))
             return
+        import logging
+
         from dask.distributed import as_completed
 
-        # the system (sympy expressions) is shipped and unpickled once per worker, not once per task
-        shared = client.scatter(tasks[0][0], broadcast=True, hash=False)
-        futures = [client.submit(fn, shared, *t[1:], pure=False) for t in tasks]
-        for fut in as_completed(futures):
-            rows = fut.result()
-            store.append(rows)
-            bar.update(len(rows))
+        # Ctrl-C inside a wait on the client makes distributed cancel that wait from its event loop,
+        # where the cancel can fail on a future that has just finished; tornado then logs the failure
+        # with a traceback from the loop's thread, racing amble's one-line "interrupted". Task errors
+        # reach this thread through fut.result(), so the loop's own log is muted while tasks run
+        # (and after a failure, until the process ends).
+        loop_log = logging.getLogger("tornado.application")
+        level = loop_log.level
+        loop_log.setLevel(logging.CRITICAL)
+        try:
+            # the system (sympy expressions) is shipped and unpickled once per worker, not once per task
+            shared = client.scatter(tasks[0][0], broadcast=True, hash=False)
+            futures = [client.submit(fn, shared, *t[1:], pure=False) for t in tasks]
+            for fut in as_completed(futures):
+                rows = fut.result()
+                store.append(rows)
+                bar.update(len(rows))
+        except BaseException:
+            raise  # the cancel's log may come later from the loop's thread: the loop stays muted
+        else:
+            loop_log.setLevel(level)
     finally:
         bar.close()
 
