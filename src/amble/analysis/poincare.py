@@ -180,10 +180,17 @@ class ReturnMap:
         if method != "exact":
             S, E = self._chart(Section.of(self, x))
             return _jacobian(self, x, E, S, method), S, E
-        _, _, s, impact = self._sensitivity_run(x, False, impact=True)
+        return self.map_and_section_jacobian(x)[2:]
+
+    def map_and_section_jacobian(self, x: np.ndarray
+                                 ) -> tuple[np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:
+        """``P(x)``, the elapsed time and :meth:`section_jacobian` ``(A, S, E)`` (exact) from the
+        same compiled run: the variational equations do not change the run's steps, so ``P(x)``
+        is the plain map's to the bit and a Newton step needs no run of its own to evaluate it."""
+        Px, t, s, impact = self._sensitivity_run(x, False, impact=True)
         assert impact is not None
         S, E = self._chart(Section(self.k, self.p, *impact))
-        return (s.dx_dx0 @ E)[S, :], S, E
+        return Px, t, (s.dx_dx0 @ E)[S, :], S, E
 
     def _chart(self, sec: Section) -> tuple[np.ndarray, np.ndarray]:
         """``(S, E)`` of the section ``sec``: :func:`amble.analysis.section.chart` of its tangent
@@ -383,12 +390,17 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
     it = 0
     res = math.inf
     for it in range(1, max_iter + 1):
-        Py, T = P(y)
+        # exact: the map and its Jacobian in one run (also the multipliers' Jacobian when converged)
+        if method == "exact":
+            Py, T, A, S, E = P.map_and_section_jacobian(y)
+        else:
+            Py, T = P(y)
         r = Py - y
         res = float(np.max(np.abs(r)))
         if res < tol:
             break
-        A, S, E = P.section_jacobian(y, method)
+        if method != "exact":
+            A, S, E = P.section_jacobian(y, method)
         try:
             dxi = np.linalg.solve(A - np.eye(len(S)), -r[S])
         except np.linalg.LinAlgError:
@@ -416,7 +428,8 @@ def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol:
         return _newton(system, ReturnMap(system, dict(zip(P.k.meta["params"], P.p.tolist())), period=lower,
                                          rtol=P.opts.rtol, atol=P.opts.atol, mode=P.mode), xs, lower, tol, max_iter,
                        method, requested or period)
-    A, S, E = P.section_jacobian(xs, method)
+    if method != "exact":
+        A, S, E = P.section_jacobian(xs, method)
     mult = np.linalg.eigvals(A)
     mult = mult[np.argsort(-np.abs(mult))]
     names = P.k.meta["state_names"][P.mode]
