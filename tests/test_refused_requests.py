@@ -59,11 +59,15 @@ def test_more_workers_than_cores_are_capped_with_a_warning():
 def test_a_cluster_asked_for_64_workers_starts_one_per_core():
     """64 worker processes on two cores took minutes to start and leaked their semaphores."""
     with pytest.warns(UserWarning, match="more than the"):
-        client, close = open_client(None, 64)
+        client, close = open_client("dask", 64)
     try:
         assert len(client.scheduler_info()["workers"]) == cores()
     finally:
         close()
+    with pytest.warns(UserWarning, match="more than the"):
+        local, close = open_client(None, 64)  # local processes: as many as cores, or this process
+    close()
+    assert getattr(local, "workers", 1) == cores()
 
 
 def _interrupt_when(cmd: list[str], ready: str, env: dict[str, str], timeout: float = 600) -> tuple[int, list[str]]:
@@ -101,10 +105,12 @@ def test_ctrl_c_during_a_gait_optimisation_is_an_interrupt_not_a_solver_failure(
     assert not any("failed" in ln or "Traceback" in ln for ln in lines)
 
 
-def test_ctrl_c_on_a_dask_sweep_prints_one_line(tmp_path):
+@pytest.mark.parametrize("scheduler", [[], ["--scheduler", "dask"]], ids=["local-processes", "dask"])
+def test_ctrl_c_on_a_sweep_on_workers_prints_one_line(tmp_path, scheduler):
     """Once ≈150 lines of distributed's warnings and tracebacks, from the client and each worker."""
     env = {**os.environ, "AMBLE_CACHE_DIR": str(tmp_path / "cache")}
-    cmd = ["sweep", "compass-gait", "--param", "slope=0.01:0.08:400", "--param", "mh=5:15:40", "--workers", "2"]
+    cmd = ["sweep", "compass-gait", "--param", "slope=0.01:0.08:400", "--param", "mh=5:15:40", "--workers", "2",
+           *scheduler]
     code, lines = _interrupt_when(cmd, r"\| *[1-9][0-9]*/16000", env)  # the workers are at work
     time.sleep(0.5)
     assert code == 130

@@ -20,7 +20,7 @@ def test_local_cluster_is_quiet_when_port_8787_is_taken():
     try:
         with warnings.catch_warnings(record=True) as seen:
             warnings.simplefilter("always")
-            client, close = open_client(None, workers=1)
+            client, close = open_client("dask", workers=1)
             close()
         assert not [w for w in seen if "already in use" in str(w.message)]
     finally:

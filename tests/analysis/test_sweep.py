@@ -187,16 +187,49 @@ def test_cli_sweep(tmp_path, capsys):
                  "--param", "mh=9:10:2", "--scheduler", "synchronous"]) == 2
 
 
-def test_fixed_point_sweep_on_two_dask_workers_equals_the_serial_sweep(compass):
-    """Four slopes in two tasks of two (warm-started inside each task) on a local cluster of two
-    worker processes: every row — state, step time, multipliers, seeding — is the serial sweep's,
-    digit for digit (the same point is the same computation wherever it runs)."""
+@pytest.mark.parametrize("scheduler", [None, "dask"], ids=["local-processes", "dask"])
+def test_fixed_point_sweep_on_two_workers_equals_the_serial_sweep(compass, scheduler):
+    """Four slopes in two tasks of two (warm-started inside each task) on two local worker
+    processes (forked, the default) or a local Dask cluster of two: every row — state, step time,
+    multipliers, seeding — is the serial sweep's, digit for digit (the same point is the same
+    computation wherever it runs)."""
     vals = [0.04, 0.05, 0.06, 0.07]
     serial = sweep(compass, "fixed-point", {"slope": vals}, chunk=2, **SYNC)
-    dist = sweep(compass, "fixed-point", {"slope": vals}, chunk=2, workers=2, progress=False)
+    dist = sweep(compass, "fixed-point", {"slope": vals}, chunk=2, workers=2, scheduler=scheduler, progress=False)
     assert [r["status"] for r in serial.rows] == ["ok"] * 4
     assert [r["seeded"] for r in serial.rows] == ["false", "true", "false", "true"]
     assert dist.rows == serial.rows
+
+
+def test_a_basin_on_two_local_processes_equals_the_serial_basin(compass):
+    xs = find_fixed_point(compass).fixed_point
+    over = _box(("stance", "stance_dot"), ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.2, xs[2] + 0.2)), (4, 4))
+    serial = sweep(compass, "basin", over, steps=30, **SYNC)
+    local = sweep(compass, "basin", over, steps=30, workers=2, progress=False, rows_per_task=1)
+    assert np.array_equal(serial.outcome, local.outcome)
+    assert set(serial.outcome.ravel()) != {serial.outcome.ravel()[0]}  # the box holds more than one outcome
+
+
+def test_a_failing_task_on_local_processes_keeps_the_finished_rows(compass, tmp_path, monkeypatch):
+    """A task that raises ends the sweep with its error; rows that landed before stay in the file."""
+    import amble.analysis.fixed_points as fp
+
+    real = fp._fp_task
+
+    def failing(system, base, pnames, points, *rest):
+        if points[0][0] >= 2:
+            raise RuntimeError("task blew up")
+        return real(system, base, pnames, points, *rest)
+
+    monkeypatch.setattr(fp, "_fp_task", failing)
+    out = tmp_path / "f.csv"
+    with pytest.raises(RuntimeError, match="task blew up"):
+        sweep(compass, "fixed-point", {"slope": [0.04, 0.05, 0.06, 0.07]}, chunk=1, workers=2, progress=False,
+              out=out)
+    monkeypatch.setattr(fp, "_fp_task", real)
+    kept = list(csv.DictReader(out.open()))
+    again = sweep(compass, "fixed-point", {"slope": [0.04, 0.05, 0.06, 0.07]}, chunk=1, **SYNC, out=out)
+    assert again.reused == len(kept) and again.computed == 4 - len(kept)
 
 
 @pytest.mark.slow
@@ -204,7 +237,7 @@ def test_local_cluster_matches_serial(compass, tmp_path):
     xs = find_fixed_point(compass).fixed_point
     over = _box(("stance", "stance_dot"), ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.2, xs[2] + 0.2)), (6, 6))
     serial = sweep(compass, "basin", over, steps=30, **SYNC)
-    dist = sweep(compass, "basin", over, steps=30, workers=2, progress=False, rows_per_task=2)
+    dist = sweep(compass, "basin", over, steps=30, workers=2, scheduler="dask", progress=False, rows_per_task=2)
     assert np.array_equal(serial.outcome, dist.outcome)
 
 

@@ -1,7 +1,7 @@
-"""Running sweep work on Dask: clients, chunked tasks, and the names of run outcomes.
+"""Running sweep work: local processes, Dask clients, chunked tasks, and the names of run outcomes.
 
 Work is cut into *chunks* (a run of consecutive parameter values, one row of a 2D map, one row
-of a basin grid); each chunk is one Dask task, so a task amortises its overhead over many
+of a basin grid); each chunk is one task, so a task amortises its overhead over many
 return-map evaluations (~20 µs per compass-gait step) instead of one task per point. Chunk
 boundaries depend only on the grid and the chunk size (never on the number of workers), so a
 result does not depend on how many processes computed it. Only the client process writes the
@@ -20,10 +20,15 @@ import numpy as np
 
 from ..backend.kernels import compiled
 from ..errors import ParameterError, SchedulerError, StateError
+from .local_processes import LocalProcesses, fork_available
 from .store import ResultStore
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
     from ..modelling.hybrid import HybridSystem
+
+
+#: ``scheduler`` naming a local Dask cluster (the default is local processes without Dask)
+LOCAL_DASK = "dask"
 
 
 class _Serial:
@@ -47,23 +52,30 @@ class _Serial:
 
 
 def open_client(scheduler: Any = None, workers: int | None = None) -> tuple[Any, Callable[[], None]]:
-    """A Dask client and its closer.
+    """Where a sweep's tasks run, and its closer.
 
-    ``scheduler``: ``None`` → a :class:`dask.distributed.LocalCluster` of ``workers`` processes
-    (default: CPU count) with one thread each (the compiled integrator holds the GIL);
-    ``"synchronous"`` → run in this process (tests, debugging); a ``distributed.Client`` → used
-    as is; any other string → address of an existing scheduler.
+    ``scheduler``: ``None`` → ``workers`` local processes (default: one per core) forked from
+    this one, without Dask (:mod:`.local_processes`; one worker, or no ``fork``: this process);
+    ``"synchronous"`` → this process (tests, debugging); ``"dask"`` → a
+    :class:`dask.distributed.LocalCluster` of ``workers`` processes with one thread each (the
+    compiled integrator holds the GIL); a ``distributed.Client`` → used as is; any other string →
+    the address of an existing Dask scheduler.
     """
     if scheduler == "synchronous":
         c = _Serial()
         return c, c.close
+    if scheduler is None:
+        n = workers_for(workers)
+        c = LocalProcesses(n) if n > 1 and fork_available() else _Serial()
+        return c, c.close
+    if isinstance(scheduler, str) and not scheduler.strip():
+        raise SchedulerError("empty scheduler address: give tcp://host:port, 'dask', 'synchronous', "
+                             "or omit the option")
     from dask.distributed import Client, LocalCluster
 
     if isinstance(scheduler, Client):
         return scheduler, lambda: None
-    if scheduler is not None and not str(scheduler).strip():
-        raise SchedulerError("empty scheduler address: give tcp://host:port, 'synchronous', or omit the option")
-    if scheduler:
+    if scheduler != LOCAL_DASK:
         _check_scheduler(str(scheduler))
         try:
             client = Client(scheduler, timeout="10s")
@@ -227,6 +239,9 @@ def execute(client: Any, fn: Callable, tasks: list[tuple], store: ResultStore, p
 
     bar = tqdm(total=total, desc=desc, unit="pt", disable=not progress, leave=False)
     try:
+        if isinstance(client, LocalProcesses):
+            client.run(fn, tasks, store, bar, _children_ignore_sigint)
+            return
         if isinstance(client, _Serial):
             if threads > 1 and len(tasks) > 1:
                 _pooled(fn, tasks, store, bar, threads)

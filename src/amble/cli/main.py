@@ -345,7 +345,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.set_defaults(func=cmd_limit_cycle)
     sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
-                      "on Dask")
+                      "on local worker processes or Dask")
     model_args(sw, None)
     sw.add_argument("--kind", choices=("fixed-point", "continuation", "bifurcation", "basin"), default="fixed-point",
                     help="the fixed point on a grid of parameter values (default), pseudo-arclength "
@@ -368,10 +368,12 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     sw.add_argument("--out", help="result file FILE.csv|.parquet (resumed if it exists)")
     sw.add_argument("--plot", help="write a plot FILE.png|.svg|.pdf")
     sw.add_argument("--scheduler",
-                    help="'synchronous': run in this process, without Dask (small runs, debugging); or the "
-                         "address of an existing Dask scheduler, e.g. tcp://host:8786 (default: local "
-                         "worker processes)")
-    sw.add_argument("--workers", type=int, default=None, help="local Dask worker processes (default: cores)")
+                    help="where the tasks run (default: local worker processes forked from this one, "
+                         "without Dask): 'synchronous' in this process (small runs, debugging); 'dask' a "
+                         "local Dask cluster; or the address of an existing Dask scheduler, e.g. "
+                         "tcp://host:8786")
+    sw.add_argument("--workers", type=int, default=None,
+                    help="local worker processes, or a local Dask cluster's (default: cores)")
     sw.add_argument("--threads", type=int, default=None,
                     help="--kind basin: threads per process — with --scheduler synchronous, tasks run side by "
                          "side on this many threads of this process; on Dask, each task's walks share them "
