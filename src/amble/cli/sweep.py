@@ -3,8 +3,8 @@
 Turns the parsed options into one call of :func:`~amble.analysis.sweep.sweep` with the kind of
 ``--kind``, reads where the gait period-doubles with :func:`~amble.analysis.doubling.period_doubling`
 and every fold, flip and torus point a branch crosses with
-:func:`~amble.analysis.branch_bifurcations.bifurcations`, prints a short report (or returns it for ``--json``) and draws the plot. Bad input raises
-:class:`amble.cli.UsageError` (exit code 2) before any work starts.
+:func:`~amble.analysis.branch_bifurcations.bifurcations`, prints a short report (or returns it for
+``--json``) and draws the plot. Bad input raises :class:`amble.cli.UsageError` (exit code 2) before any work starts.
 """
 
 from __future__ import annotations
