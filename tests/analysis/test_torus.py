@@ -178,3 +178,47 @@ def test_cli_reports_the_torus_point(tmp_path, capsys):
     (line,) = [ln for ln in out.splitlines() if ln.startswith("  torus")]
     assert "Neimark–Sacker" in line and f"c = {cstar:.12g}" in line and "unstable→stable" in line
     assert amble.bifurcations is bifurcations
+
+
+@pytest.mark.slow
+def test_humanoid_torso_damping_torus_point_against_scipy_oracle():
+    """A walker with a genuine torus point: the 2D humanoid's torso PD loses its damping ``kv``
+    and the complex pair of its gait leaves the circle near kv = 1.1656 N·m·s/rad. Truth: the same
+    robot written out and integrated by SciPy (tests/oracles/humanoid_2d.py), its own fixed point
+    (Newton on its map) and multipliers (central differences), and the kv where its pair's
+    modulus is 1 (secant in kv)."""
+    from oracles.humanoid_2d import PARAMS, jacobian, on_section, step
+
+    from amble.models import load
+
+    br = continue_branch(load("humanoid-2d"), "kv", 2.0, 0.5, max_delta=0.1)
+    (torus,) = br.tori()
+    assert torus.located and torus.direction == "stable→unstable" and torus.resonance is None
+    idx = [0, 2, 3, 4, 6, 7]
+
+    def pair(kv: float, x: np.ndarray) -> tuple[complex, np.ndarray]:
+        p = dict(PARAMS, kv=kv)
+        z = x[idx]
+        for _ in range(6):  # Newton on the oracle's 6-D map z ↦ z
+            r = step(on_section(z), p)[0][idx] - z
+            if np.max(np.abs(r)) < 1e-11:
+                break
+            z = z - np.linalg.solve(jacobian(on_section(z), p) - np.eye(6), r)
+        mu = np.linalg.eigvals(jacobian(on_section(z), p))
+        top = max((m for m in mu if m.imag > 1e-6), key=abs)
+        return top, on_section(z)
+
+    x = torus.point.state
+    k0, k1 = torus.value - 0.02, torus.value + 0.02
+    (m0, _), (m1, x1) = pair(k0, x), pair(k1, x)
+    assert abs(m0) > 1 > abs(m1)  # the oracle's pair crosses between them
+    for _ in range(4):  # secant on |μ(kv)| − 1
+        k2 = k1 - (abs(m1) - 1) * (k1 - k0) / (abs(m1) - abs(m0))
+        m2, x1 = pair(k2, x1)
+        k0, m0, k1, m1 = k1, m1, k2, m2
+        if abs(k1 - k0) < 1e-7:
+            break
+    print(f"kv: amble {torus.value:.10f}, oracle {k1:.10f}; θ: amble {torus.angle:.10f}, "
+          f"oracle {abs(np.angle(m1)):.10f}")
+    assert abs(torus.value - k1) < 1e-5
+    assert abs(torus.angle - abs(np.angle(m1))) < 1e-5
