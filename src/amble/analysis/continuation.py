@@ -1,5 +1,5 @@
-"""Pseudo-arclength continuation of periodic gaits in one parameter, with folds and period
-doublings located and the period-doubled branch followed.
+"""Pseudo-arclength continuation of periodic gaits in one parameter, with folds, period
+doublings and torus (Neimark–Sacker) points located and the period-doubled branch followed.
 
 A period-k gait at parameter value λ is a zero of
 
@@ -286,9 +286,9 @@ def continue_branch(
     The branch is traced by pseudo-arclength until the parameter leaves [start, stop] (the last
     point is then corrected onto ``param = stop`` exactly), ``max_points`` points, or the
     corrector fails at the smallest step (``Branch.end`` says which). ``max_delta``: largest
-    change of the parameter per step (default |stop − start| / 50). Folds and flips between two
-    points are located (``locate``) to :data:`LOCATE_TOL`; ``tol``: the residual ``|P(x) − x|∞``
-    of every point.
+    change of the parameter per step (default |stop − start| / 50). Folds, flips and torus
+    (Neimark–Sacker) points between two points are located (``locate``) to :data:`LOCATE_TOL`;
+    ``tol``: the residual ``|P(x) − x|∞`` of every point.
     """
     from .poincare import find_fixed_point
 
