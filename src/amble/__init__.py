@@ -44,9 +44,10 @@ _WHERE: dict[str, str] = {
     # deprecated aliases (each warns, naming its replacement)
     "sweep": ".analysis.sweep",
     "period_doubling": ".analysis.doubling",
+    "bifurcations": ".analysis.branch_bifurcations",
     **dict.fromkeys(("sweep_fixed_points", "sweep_fixed_points_2d"), ".analysis.fixed_points"),
     **dict.fromkeys(("bifurcation", "poincare_iterates"), ".analysis.bifurcation"),
-    **dict.fromkeys(("cascade", "continue_branch", "switch_at_flip"), ".analysis.continuation"),
+    **dict.fromkeys(("cascade", "continue_branch", "locate_bifurcation", "switch_at_flip"), ".analysis.continuation"),
     "basin": ".analysis.basin",
     "find_gaits": ".analysis.gaits",
     "period_doublings": ".analysis.doublings",

@@ -106,7 +106,7 @@ def test_multiplier_at_the_located_flip_is_minus_one(compass, flip_branch):
 
 def test_test_functions_are_the_products_over_multipliers(compass):
     lc = find_fixed_point(compass, params={"slope": 0.05})
-    fold, flip = _tests(lc.jacobian)
+    fold, flip, _ = _tests(lc.jacobian)
     assert fold == pytest.approx(float(np.prod(lc.multipliers - 1).real), rel=1e-9)
     assert flip == pytest.approx(float(np.prod(lc.multipliers + 1).real), rel=1e-9)
 

@@ -1,5 +1,5 @@
-"""Pseudo-arclength continuation of periodic gaits in one parameter, with folds and period
-doublings located and the period-doubled branch followed.
+"""Pseudo-arclength continuation of periodic gaits in one parameter, with folds, period
+doublings and torus (Neimark–Sacker) points located and the period-doubled branch followed.
 
 A period-k gait at parameter value λ is a zero of
 
@@ -24,10 +24,14 @@ a failed one; a step's change of λ is capped (``max_delta``) and so is its leng
 **Test functions.** With ``A = Uᵀ (∂P/∂x) U`` (``U`` an orthonormal basis of Σ's tangent space,
 :meth:`Section.tangent`; ``A``'s eigenvalues are the multipliers, whatever the basis)
 
-    ψ_fold = det(A − I),     ψ_flip = det(A + I)
+    ψ_fold = det(A − I),     ψ_flip = det(A + I),     ψ_torus = det(A ⊙ A − I)
 
 change sign where a real multiplier crosses +1 (a fold) or −1 (a period doubling); a complex
-pair never changes their sign (|μ ∓ 1|² > 0). A sign change between two branch points is located
+pair never changes the first two's sign (|μ ∓ 1|² > 0), but crosses the unit circle where ψ_torus
+(``A ⊙ A`` the bialternate product, eigenvalues μᵢμⱼ, :mod:`amble.analysis.multipliers`) changes
+sign: a Neimark–Sacker (torus) bifurcation, reported with the pair's angle θ = arg μ there. A zero
+of ψ_torus where the pair with μᵢμⱼ = 1 is real (a neutral saddle) is no bifurcation and is
+dropped. A sign change between two branch points is located
 by the secant method (Newton with the derivative from the last two iterates: dψ/dσ needs second
 derivatives of the map) on ``ψ(σ)``, where ``σ ∈ [0, 1]`` runs along the chord between the two
 points and each ``σ`` is corrected onto the branch in the hyperplane normal to the chord. Secant
@@ -53,6 +57,7 @@ import numpy as np
 from ..errors import AmbleError, ConvergenceError, StateError
 from ..simulation.engine import run
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .multipliers import KINDS, crossing_functions, resonance, torus_pair
 from .section import Section
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy
@@ -90,8 +95,9 @@ class BranchPoint:
 @dataclass
 class BifurcationPoint:
     """A fold (a real multiplier through +1: a turning point of the branch, or a branch point
-    such as a period-1 orbit continued as a 2-step fixed point at its flip) or a flip (one
-    through −1) located on a branch: ``kind`` ``"fold"`` or ``"flip"``, the gait there
+    such as a period-1 orbit continued as a 2-step fixed point at its flip), a flip (one
+    through −1) or a torus (Neimark–Sacker) point (a complex pair through the unit circle)
+    located on a branch: ``kind`` ``"fold"``, ``"flip"`` or ``"torus"``, the gait there
     (``point``) and the test function's value."""
 
     kind: str
@@ -100,10 +106,46 @@ class BifurcationPoint:
     #: False when the location failed (e.g. the corrector at a branch point, where two branches
     #: cross): ``point`` is then the bracketing branch point with the smaller |test|
     located: bool = True
+    #: the gait's stability on either side, in the order the branch was traced (parameter
+    #: increasing for a sweep's grid): ``"stable→unstable"``, ``"unstable→stable"`` or
+    #: ``"unstable→unstable"`` (another multiplier outside the unit circle on both sides)
+    direction: str = ""
 
     @property
     def value(self) -> float:
         return self.point.value
+
+    @property
+    def angle(self) -> float | None:
+        """A torus point's θ = |arg μ| (rad, in [0, π]) of the pair on the unit circle; ``None``
+        for a fold or a flip."""
+        pair = torus_pair(self.point.multipliers) if self.kind == "torus" else None
+        return pair[1] if pair else None
+
+    @property
+    def rotation(self) -> float | None:
+        """A torus point's rotation number θ / 2π (turns per step of the map) of the invariant
+        circle born there; ``None`` for a fold or a flip."""
+        a = self.angle
+        return None if a is None else a / (2 * math.pi)
+
+    @property
+    def resonance(self) -> str | None:
+        """A torus point at a strong resonance (θ = 0, π, 2π/3, π/2 within
+        :data:`~amble.analysis.multipliers.RESONANCE_TOL`): ``"1:1"``, ``"1:2"``, ``"1:3"`` or
+        ``"1:4"``; otherwise ``None``."""
+        a = self.angle
+        return None if a is None else resonance(a)
+
+    def to_json(self) -> dict[str, Any]:
+        """The point as plain data: kind, parameter value, period, multipliers ([re, im] pairs),
+        located, direction, and for a torus point its angle, rotation number and resonance."""
+        out: dict[str, Any] = {"kind": self.kind, "value": self.value, "period": len(self.point.orbit),
+                               "multipliers": [[float(m.real), float(m.imag)] for m in self.point.multipliers],
+                               "located": self.located, "direction": self.direction}
+        if self.kind == "torus":
+            out.update(angle=self.angle, rotation=self.rotation, resonance=self.resonance)
+        return out
 
 
 @dataclass
@@ -127,6 +169,10 @@ class Branch:
 
     def folds(self) -> list[BifurcationPoint]:
         return [b for b in self.bifurcations if b.kind == "fold"]
+
+    def tori(self) -> list[BifurcationPoint]:
+        """The torus (Neimark–Sacker) points: a complex pair of multipliers through |μ| = 1."""
+        return [b for b in self.bifurcations if b.kind == "torus"]
 
 
 class _Problem:
@@ -183,10 +229,9 @@ class _Problem:
         return np.array(pts), [float(v) for v in times]
 
 
-def _tests(A: np.ndarray) -> tuple[float, float]:
-    """(ψ_fold, ψ_flip) = (det(A − I), det(A + I))."""
-    eye = np.eye(A.shape[0])
-    return float(np.linalg.det(A - eye)), float(np.linalg.det(A + eye))
+def _tests(A: np.ndarray) -> tuple[float, float, float]:
+    """(ψ_fold, ψ_flip, ψ_torus) = (det(A − I), det(A + I), det(A ⊙ A − I)), in ``KINDS`` order."""
+    return crossing_functions(A)
 
 
 def _null(J: np.ndarray, prev: np.ndarray | None) -> np.ndarray:
@@ -241,9 +286,9 @@ def continue_branch(
     The branch is traced by pseudo-arclength until the parameter leaves [start, stop] (the last
     point is then corrected onto ``param = stop`` exactly), ``max_points`` points, or the
     corrector fails at the smallest step (``Branch.end`` says which). ``max_delta``: largest
-    change of the parameter per step (default |stop − start| / 50). Folds and flips between two
-    points are located (``locate``) to :data:`LOCATE_TOL`; ``tol``: the residual ``|P(x) − x|∞``
-    of every point.
+    change of the parameter per step (default |stop − start| / 50). Folds, flips and torus
+    (Neimark–Sacker) points between two points are located (``locate``) to :data:`LOCATE_TOL`;
+    ``tol``: the residual ``|P(x) − x|∞`` of every point.
     """
     from .poincare import find_fixed_point
 
@@ -301,9 +346,11 @@ def _trace(prob: _Problem, u: np.ndarray, start: float, stop: float, max_delta: 
         ptn = prob.point(un, Jn, resn, s)
         testn = _tests(prob.reduced(un, Jn))
         if locate:
-            for kind, a, b in (("fold", tests[0], testn[0]), ("flip", tests[1], testn[1])):
+            for kind, a, b in zip(KINDS, tests, testn):
                 if a * b < 0:
-                    br.bifurcations.append(_bracketed(prob, u, un, kind, tol, (br.points[-1], a), (ptn, b)))
+                    bp = _bracketed(prob, u, un, kind, tol, (br.points[-1], a), (ptn, b))
+                    if bp is not None:  # None: a neutral saddle, no bifurcation
+                        br.bifurcations.append(bp)
         br.points.append(ptn)
         u, t, tests = un, tn, testn
         if not lo < u[-1] < hi:
@@ -320,7 +367,7 @@ def _locate(prob: _Problem, ua: np.ndarray, ub: np.ndarray, kind: str, tol: floa
     secant step leaves the bracket), each σ corrected onto the branch normal to the chord."""
     d = ub - ua
     nd = d / np.linalg.norm(d)
-    which = 0 if kind == "fold" else 1
+    which = KINDS.index(kind)
 
     def at(sig: float) -> tuple[float, np.ndarray, np.ndarray, float]:
         u0 = ua + sig * d
@@ -351,29 +398,41 @@ def _locate(prob: _Problem, ua: np.ndarray, ub: np.ndarray, kind: str, tol: floa
 
 
 def _bracketed(prob: _Problem, ua: np.ndarray, ub: np.ndarray, kind: str, tol: float,
-               near_a: tuple[BranchPoint, float], near_b: tuple[BranchPoint, float]) -> BifurcationPoint:
+               near_a: tuple[BranchPoint, float], near_b: tuple[BranchPoint, float]) -> BifurcationPoint | None:
     """The bifurcation between two branch points whose test functions differ in sign, located
     (:func:`_locate`); when the location fails, the bracketing point with the smaller |test|
-    (``located=False``). ``near_a``, ``near_b``: each end's point and test value."""
+    (``located=False``). ``near_a``, ``near_b``: each end's point and test value. ``None`` for
+    a zero of ψ_torus whose pair is real and distinct (a neutral saddle: no bifurcation)."""
     try:
-        return _locate(prob, ua, ub, kind, tol)
+        bp = _locate(prob, ua, ub, kind, tol)
     except AmbleError:  # ConvergenceError, SimulationError: e.g. the corrector at a branch point
         pt, test = near_a if abs(near_a[1]) < abs(near_b[1]) else near_b
-        return BifurcationPoint(kind, pt, test, located=False)
+        bp = BifurcationPoint(kind, pt, test, located=False)
+    if kind == "torus" and torus_pair(bp.point.multipliers) is None:
+        return None
+    bp.direction = "→".join("stable" if p.stable else "unstable" for p in (near_a[0], near_b[0]))
+    return bp
 
 
-def locate_flip(system: HybridSystem, param: str, a: tuple[Sequence[float], float], b: tuple[Sequence[float], float],
-                *, params: Mapping[str, float] | None = None, period: int = 1, rtol: float = FIXED_POINT_TOL,
-                atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL) -> BifurcationPoint | None:
-    """The period doubling between two gaits of one branch: where a real multiplier crosses −1.
+def locate_bifurcation(system: HybridSystem, param: str, a: tuple[Sequence[float], float],
+                       b: tuple[Sequence[float], float], kind: str, *, params: Mapping[str, float] | None = None,
+                       period: int = 1, rtol: float = FIXED_POINT_TOL, atol: float = FIXED_POINT_TOL,
+                       tol: float = RESIDUAL_TOL) -> BifurcationPoint | None:
+    """The bifurcation of ``kind`` (``"fold"``, ``"flip"`` or ``"torus"``) between two gaits of one branch.
 
     ``a``, ``b``: (post-impact state, value of ``param``) of two period-``period`` gaits (fixed
-    points to ``tol``), e.g. neighbouring points of a sweep. ``ψ_flip = det(A + I)`` is evaluated
-    at both; if it changes sign between them, its zero is located on the branch by the secant
-    method with bisection, each iterate corrected onto the branch (:func:`_locate`, the location
-    continuation uses, to :data:`LOCATE_TOL` in the parameter); ``None`` when the signs agree
-    (no flip between them, or two). ``params``: the other parameters, as in the sweep.
+    points to ``tol``), e.g. neighbouring points of a sweep, in the order of the branch. The
+    kind's test function (ψ_fold = det(A − I), ψ_flip = det(A + I), ψ_torus = det(A ⊙ A − I):
+    a real multiplier through +1 or −1, or a complex pair through |μ| = 1) is evaluated at both;
+    if it changes sign between them, its zero is located on the branch by the secant method with
+    bisection, each iterate corrected onto the branch (:func:`_locate`, the location continuation
+    uses, to :data:`LOCATE_TOL` in the parameter). ``None`` when the signs agree (no crossing
+    between them, or two), or for ``"torus"`` when the zero is a neutral saddle (a real pair with
+    μ₁μ₂ = 1: no bifurcation). ``params``: the other parameters, as in the sweep.
     """
+    if kind not in KINDS:
+        raise StateError(f"unknown bifurcation kind {kind!r}; known: {', '.join(KINDS)}")
+    which = KINDS.index(kind)
     prob = _Problem(system, params, param, period, rtol, atol)
     ends = []
     for x, lam in (a, b):
@@ -381,10 +440,19 @@ def locate_flip(system: HybridSystem, param: str, a: tuple[Sequence[float], floa
         r, J = prob.F(u)
         ends.append((u, J, float(np.max(np.abs(r)))))
     (ua, Ja, ra), (ub, Jb, rb) = ends
-    fa, fb = _tests(prob.reduced(ua, Ja))[1], _tests(prob.reduced(ub, Jb))[1]
+    fa, fb = _tests(prob.reduced(ua, Ja))[which], _tests(prob.reduced(ub, Jb))[which]
     if not fa * fb < 0:
         return None
-    return _bracketed(prob, ua, ub, "flip", tol, (prob.point(ua, Ja, ra, 0.0), fa), (prob.point(ub, Jb, rb, 0.0), fb))
+    return _bracketed(prob, ua, ub, kind, tol, (prob.point(ua, Ja, ra, 0.0), fa), (prob.point(ub, Jb, rb, 0.0), fb))
+
+
+def locate_flip(system: HybridSystem, param: str, a: tuple[Sequence[float], float], b: tuple[Sequence[float], float],
+                *, params: Mapping[str, float] | None = None, period: int = 1, rtol: float = FIXED_POINT_TOL,
+                atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL) -> BifurcationPoint | None:
+    """The period doubling between two gaits of one branch: where a real multiplier crosses −1
+    (:func:`locate_bifurcation` of kind ``"flip"``)."""
+    return locate_bifurcation(system, param, a, b, "flip", params=params, period=period, rtol=rtol, atol=atol,
+                              tol=tol)
 
 
 def switch_at_flip(system: HybridSystem, flip: BifurcationPoint, param: str, stop: float, *,
@@ -446,5 +514,5 @@ def cascade(system: HybridSystem, param: str, start: float, stop: float, *, leve
     return out
 
 
-__all__ = ["Branch", "BranchPoint", "BifurcationPoint", "LOCATE_TOL", "cascade", "continue_branch", "locate_flip",
-           "switch_at_flip"]
+__all__ = ["Branch", "BranchPoint", "BifurcationPoint", "LOCATE_TOL", "cascade", "continue_branch",
+           "locate_bifurcation", "locate_flip", "switch_at_flip"]

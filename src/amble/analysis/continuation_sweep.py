@@ -1,13 +1,14 @@
 """The ``continuation`` kind of :func:`amble.sweep`: branches of gaits traced by pseudo-arclength
 (:mod:`amble.analysis.continuation`) written as the rows of a result file.
 
-One row per branch point and one per located bifurcation. Key ``branch, row, i``: ``branch`` 0
-is the period-1 branch, ``branch`` b + 1 the period-doubled branch born at the first flip of
-branch b; ``row`` is ``point``, ``fold`` or ``flip``; ``i`` counts along the branch (points in
-the order traced, bifurcations in the order found). Continuation is sequential and deterministic,
-so it runs in this process (no Dask) and its rows are written when the branches are done; a rerun
-on the same file keeps the stored rows and adds missing ones, and a file holding another
-continuation (rows this one does not have, or another start) is refused with ``OutputError``.
+One row per branch point and one per located bifurcation. Key ``branch, row, i``: ``branch`` 0 is
+the period-1 branch, ``branch`` b + 1 the period-doubled branch born at the first flip of branch
+b; ``row`` is ``point``, ``fold``, ``flip`` or ``torus`` (a Neimark–Sacker point); ``i`` counts
+along the branch (points in the order traced, bifurcations in the order found). Continuation is
+sequential and deterministic, so it runs in this process (no Dask) and its rows are written when
+the branches are done; a rerun on the same file keeps the stored rows and adds missing ones, and a
+file holding another continuation (rows this one does not have, or another start) is refused with
+``OutputError``.
 
 Units: the parameter in its own units, states in the model's (rad, rad/s), times in s.
 """
@@ -15,6 +16,7 @@ Units: the parameter in its own units, states in the model's (rad, rad/s), times
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -24,6 +26,7 @@ import numpy as np
 from ..errors import AmbleError, OutputError, StateError
 from .continuation import Branch, BranchPoint, cascade
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .multipliers import KINDS, resonance, torus_pair
 from .runner import sweep_values
 from .store import ResultStore, SweepResult, fmt_value, state_columns
 from .sweep_runner import RunOptions, deprecated, prepared
@@ -37,7 +40,7 @@ def continuation_columns(param: str, snames: Sequence[str]) -> dict[str, str]:
     return {"branch": "int", "row": "str", "i": "int", param: "float", "period": "int", "status": "str",
             "reason": "str", **dict.fromkeys(state_columns(snames), "float"), "step_time": "float",
             "step_times": "json", "orbit": "json", "max_modulus": "float", "moduli": "json", "multipliers": "json",
-            "stable": "bool", "residual": "float", "arclength": "float", "test": "float"}
+            "stable": "bool", "residual": "float", "arclength": "float", "test": "float", "direction": "str"}
 
 
 def _row(b: int, kind: str, i: int, param: str, period: int, pt: BranchPoint, snames: Sequence[str],
@@ -60,7 +63,7 @@ def branch_rows(b: int, br: Branch, snames: Sequence[str]) -> list[dict[str, Any
     if rows:
         rows[-1]["reason"] = br.end  # why the branch ended, on its last point
     rows += [{**_row(b, bf.kind, i, br.param, br.period, bf.point, snames, bf.test),
-              "reason": "" if bf.located else "not located: the nearest branch point"}
+              "reason": "" if bf.located else "not located: the nearest branch point", "direction": bf.direction}
              for i, bf in enumerate(br.bifurcations)]
     return rows
 
@@ -132,12 +135,30 @@ def sweep_continuation(
 
 
 def bifurcation_rows(result: SweepResult) -> list[dict[str, Any]]:
-    """The located folds and flips of a continuation result: branch, kind, period, parameter
-    value, step times and multipliers."""
+    """The located folds, flips and torus points of a continuation result: branch, kind,
+    period, parameter value, step times, multipliers, direction (stability before → after) and,
+    for a torus point, the pair's angle θ (rad), rotation number θ/2π and strong resonance."""
     p = result.params[0]
-    return [{"branch": int(r["branch"]), "kind": r["row"], "period": int(r["period"]), p: float(r[p]),
-             "step_times": json.loads(r["step_times"]), "multipliers": json.loads(r["multipliers"])}
-            for r in result.rows if r["row"] in ("fold", "flip") and r["status"] == "ok"]
+    out = []
+    for r in result.rows:
+        if r["row"] not in KINDS or r["status"] != "ok":
+            continue
+        row = {"branch": int(r["branch"]), "kind": r["row"], "period": int(r["period"]), p: float(r[p]),
+               "step_times": json.loads(r["step_times"]), "multipliers": json.loads(r["multipliers"]),
+               "direction": r.get("direction", "")}
+        if r["row"] == "torus":
+            row.update(torus_fields([complex(a, b) for a, b in row["multipliers"]]))
+        out.append(row)
+    return out
 
 
-__all__ = ["bifurcation_rows", "branch_rows", "continuation_columns", "continuation_kind", "sweep_continuation"]
+def torus_fields(multipliers: Sequence[complex]) -> dict[str, Any]:
+    """A torus point's pair as plain data: ``angle`` θ (rad), ``rotation`` θ/2π, ``resonance``."""
+    pair = torus_pair(np.asarray(multipliers, complex))
+    if pair is None:
+        return {"angle": None, "rotation": None, "resonance": None}
+    return {"angle": pair[1], "rotation": pair[1] / (2 * math.pi), "resonance": resonance(pair[1])}
+
+
+__all__ = ["bifurcation_rows", "branch_rows", "continuation_columns", "continuation_kind", "sweep_continuation",
+           "torus_fields"]

@@ -7,6 +7,8 @@ each iterate corrected onto the branch. Continuation locates the flips it passes
 traces a branch; :func:`period_doubling` finds the bracketing pair in the rows of a fixed-point
 branch and locates the flip between them with it. A bifurcation diagram holds no multipliers:
 from it, the first value whose attractor repeats with a period of 2 or more is what is known.
+Every fold, flip and torus point a branch crosses, by one mechanism, is
+:func:`~amble.analysis.branch_bifurcations.bifurcations`.
 
 Units: the swept parameter in its own units.
 """

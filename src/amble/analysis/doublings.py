@@ -45,7 +45,8 @@ FEIGENBAUM_DELTA = 4.669201609102990
 @dataclass
 class Cascade:
     """The branches of a cascade (periods 1, 2, 4, …), the flips found (``flips[n]``: the first
-    flip of ``branches[n]``, where the period ``2^n`` gait period-doubles) and why it ended."""
+    flip of ``branches[n]``, where the period ``2^n`` gait period-doubles) and why it ended.
+    Torus (Neimark–Sacker) points the branches cross are on each branch (:meth:`Branch.tori`)."""
 
     param: str
     branches: list[Branch] = field(default_factory=list)
@@ -72,6 +73,7 @@ class Cascade:
         return {"param": self.param, "periods": [b.period for b in self.branches],
                 "flips": [{"period": b.period, "value": f.value, "located": f.located}
                           for b, f in zip(self.branches, self.flips)],
+                "tori": [{**t.to_json(), "branch": n} for n, b in enumerate(self.branches) for t in b.tori()],
                 "intervals": self.intervals.tolist(), "ratios": self.ratios.tolist(), "end": self.end}
 
 

@@ -68,6 +68,10 @@ def cmd_doublings(args: argparse.Namespace) -> dict[str, Any]:
         for f in out["flips"]:
             located = "" if f["located"] else " (not located to tolerance)"
             print(f"  period {f['period']} doubles at {name} = {f['value']:.12g}{located}")
+        for t in out["tori"]:
+            res = f"; at the {t['resonance']} strong resonance" if t["resonance"] else ""
+            print(f"  torus (Neimark–Sacker) on the period-{t['period']} branch at {name} = {t['value']:.12g}: "
+                  f"θ = {t['angle']:.10g} rad (rotation number {t['rotation']:.8g}), {t['direction']}{res}")
         if out["ratios"]:
             print("  Feigenbaum ratios: " + ", ".join(f"{r:.4f}" for r in out["ratios"]) + " (δ → 4.6692)")
         if "plot" in out:

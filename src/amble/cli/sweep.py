@@ -1,9 +1,10 @@
 """``amble sweep``: the command-line glue between :mod:`amble.cli` and the sweep functions.
 
 Turns the parsed options into one call of :func:`~amble.analysis.sweep.sweep` with the kind of
-``--kind``, reads where the gait period-doubles with :func:`~amble.analysis.doubling.period_doubling`,
-prints a short report (or returns it for ``--json``) and draws the plot. Bad input raises
-:class:`amble.cli.UsageError` (exit code 2) before any work starts.
+``--kind``, reads where the gait period-doubles with :func:`~amble.analysis.doubling.period_doubling`
+and every fold, flip and torus point a branch crosses with
+:func:`~amble.analysis.branch_bifurcations.bifurcations`, prints a short report (or returns it for
+``--json``) and draws the plot. Bad input raises :class:`amble.cli.UsageError` (exit code 2) before any work starts.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.basin import BASIN_LABELS, BasinResult
+from ..analysis.branch_bifurcations import bifurcations
 from ..analysis.continuation_sweep import bifurcation_rows
 from ..analysis.defaults import BASIN_STEPS
 from ..analysis.doubling import period_doubling
@@ -176,6 +178,9 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
     elif len(names) == 1:
         # the flip located on the branch between the two points that bracket it
         summary["period_doubling"] = period_doubling(res, system, params=common["params"])
+        # folds, flips and torus points crossed between neighbouring gaits, each located on the branch
+        found = bifurcations(res, system, params=common["params"], **{k: common[k] for k in ("tol",) if k in common})
+        summary["bifurcations"] = [{**b.to_json(), names[0]: b.value} for b in found]
         st = [r for r in res.rows if r["status"] == "ok" and r["stable"] == "true"]
         summary["stable_range"] = [float(st[0][names[0]]), float(st[-1][names[0]])] if st else None
     else:
@@ -234,11 +239,25 @@ def _print(summary: dict[str, Any], out: Any, plot: Any) -> None:
         print(f"  branch {b['branch']}: period {b['period']}, {p} {b['range'][0]:.6g} → {b['range'][1]:.6g}, "
               f"{b['points']} points ({b['stable_points']} stable); {b['end']}")
     for b in summary.get("bifurcations", []):
-        print(f"  {b['kind']} on branch {b['branch']} (period {b['period']}) at {p} = {b[p]:.12g}")
+        print(_bifurcation_line(b, p))
     if out is not None:
         print(f"  results: {out}")
     if plot is not None:
         print(f"  plot: {plot}")
+
+
+def _bifurcation_line(b: dict[str, Any], p: str) -> str:
+    """One bifurcation of the report: kind, where, and for a torus point its pair's angle."""
+    torus = b["kind"] == "torus"
+    on = f" on branch {b['branch']}" if "branch" in b else ""
+    line = f"  {'torus (Neimark–Sacker)' if torus else b['kind']}{on} (period {b['period']}) at {p} = {b[p]:.12g}"
+    if b.get("located") is False:
+        line += " (not located: the nearest point)"
+    if torus and b.get("angle") is not None:
+        line += (f": a complex pair crosses |μ| = 1 at θ = {b['angle']:.10g} rad (rotation number "
+                 f"{b['rotation']:.8g}), {b['direction'] or 'direction unknown'}")
+        line += f"; at the {b['resonance']} strong resonance" if b.get("resonance") else ""
+    return line
 
 
 __all__ = ["sweep_cli"]

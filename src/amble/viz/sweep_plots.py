@@ -20,6 +20,8 @@ from .errors import VizError
 
 UNITS = {"slope": "rad", "mh": "kg", "m": "kg", "a": "m", "b": "m", "g": "m/s²", "l": "m", "r": "m"}
 _SUFFIXES = (".png", ".svg", ".pdf")
+#: the marker of each located bifurcation row of a continuation (fold, flip, torus)
+_MARKERS = {"fold": "^", "flip": "o", "torus": "s"}
 
 
 def _plt():
@@ -228,15 +230,17 @@ def plot_continuation(result: Any, path: str | os.PathLike, *, coordinate: str |
                         if j == 0 and mask.any() else None)
         a2.plot(v, mod, "-", color=col, lw=1.4)
         for r in ok:
-            if int(r["branch"]) == b and r["row"] in ("fold", "flip"):
+            if int(r["branch"]) == b and r["row"] in _MARKERS:
                 o = np.asarray(json.loads(r["orbit"]))[:, ci]
-                a1.plot([float(r[pname])] * len(o), o, "^" if r["row"] == "fold" else "o", color="k", ms=5)
+                a1.plot([float(r[pname])] * len(o), o, _MARKERS[r["row"]], color="k", ms=5)
                 a2.axvline(float(r[pname]), color="0.6", lw=0.8)
     kinds = {r["row"] for r in ok}
     if "flip" in kinds:
         a1.plot([], [], "o", color="k", ms=5, label="period doubling (flip, μ = −1)")
     if "fold" in kinds:
         a1.plot([], [], "^", color="k", ms=5, label="fold (μ = +1)")
+    if "torus" in kinds:
+        a1.plot([], [], "s", color="k", ms=5, label="torus (Neimark–Sacker, |μ| = 1, μ complex)")
     a2.axhline(1.0, ls="--", color="k", lw=1)
     a2.set_yscale("log")
     a1.set_ylabel(f"post-impact {_label(coord)}" if coord else "post-impact state")
