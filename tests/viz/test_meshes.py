@@ -224,7 +224,7 @@ def _standing(system, srdf: Path, state: str) -> np.ndarray:
     names = [str(q) for q in system.modes[system.name].q]
     x0 = np.zeros(2 * len(names))
     x0[: len(names)] = [float(values.get(n, 0.0)) for n in names]
-    assert sum(n in values for n in names) >= len(names) - 1
+    assert sum(n in values for n in names) >= 0.9 * len(names)   # Talos: not its 2 grippers
     return x0
 
 
