@@ -9,10 +9,10 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import AmbleError
 from ..modelling.hybrid import HybridSystem
 from ..modelling.walker import Walker
 from ..simulation.trajectory import Trajectory
-from ..errors import AmbleError
 from .errors import SceneError, VizError
 from .scene import Cylinder, Ground, Mesh, Shape, Sphere, default_look, frames
 
