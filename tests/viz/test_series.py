@@ -99,3 +99,24 @@ def test_the_panels_have_axes_a_legend_and_the_values_at_the_playhead(walk, tmp_
     for name, text in shown.items():
         digits = len(text.split(".")[1]) if "." in text else 0
         assert float(text) == pytest.approx(scene["series"][name][k], abs=0.51 * 10.0 ** -digits), name
+
+
+def test_the_command_line_chooses_the_panels(tmp_path, capsys):
+    import json
+
+    from amble.cli.main import main
+
+    page = tmp_path / "walk.html"
+    args = ["simulate", "compass-gait", "--steps", "1", "--animate", str(page)]
+    assert main([*args, "--series", "legs=stance,swing", "--series", "E=energy"]) == 0
+    scene = json.loads(re.search(r'id="amble-scene">(.*?)</script>', page.read_text(), re.S).group(1))
+    assert [(g["title"], g["series"]) for g in scene["series_groups"]] == [("legs", ["stance", "swing"]),
+                                                                         ("E", ["energy"])]
+    assert main([*args, "--series", "swing_dot,swing,stance_dot"]) == 0
+    scene = json.loads(re.search(r'id="amble-scene">(.*?)</script>', page.read_text(), re.S).group(1))
+    assert [g["series"] for g in scene["series_groups"]] == [["swing_dot", "stance_dot"], ["swing"]]
+    capsys.readouterr()
+    assert main([*args, "--series", "legs=stance", "--series", "energy"]) == 2
+    assert main(["simulate", "compass-gait", "--steps", "1", "--series", "energy"]) == 2
+    err = capsys.readouterr().err
+    assert "give every panel a title" in err and "--series needs --animate FILE.html" in err
