@@ -216,6 +216,22 @@ def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = N
                   time_unit=system.time_unit, poses=poses, meshes=meshes)
 
 
+def movie_look(traj: Trajectory, path: str | Path, fps: float, look: Sequence[Any] | None = None,
+               max_triangles: int | None = None) -> tuple[list[Any], Any]:
+    """The shapes of a movie of ``traj`` and, for a robot read from a URDF or MJCF file (without
+    a ``look``), the poses and meshes of its visuals at the movie's frames (at most
+    ``max_triangles`` triangles, default :data:`amble.viz.movie.MOVIE_TRIANGLES`; 0: balls and
+    sticks), for :func:`amble.viz.movie.write_movie`."""
+    from .movie import MOVIE_TRIANGLES, movie_times
+
+    shapes = look_of(traj.system, traj.parameters, look)
+    budget = MOVIE_TRIANGLES if max_triangles is None else int(max_triangles)
+    if look or budget <= 0:
+        return shapes, None
+    shapes, poses, meshes, _ = with_meshes(traj, movie_times(traj, path, fps), shapes, budget)
+    return shapes, ((poses, meshes) if meshes else None)
+
+
 def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None,
             progress: bool | None = None, series: SeriesSpec = None,
             max_triangles: int | None = None) -> Path:
@@ -229,8 +245,9 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
     labelled axes, a legend and a playhead showing the current values: a list of names (those of
     one unit share a panel) or a mapping panel title → names (see :func:`series_groups`; default:
     the coordinates and the energy; ``[]`` for no panel). A robot read
-    from a URDF is drawn in the ``.html`` viewer with its visual meshes, at most ``max_triangles``
-    triangles together (default :data:`amble.viz.meshes.MAX_TRIANGLES`; 0: balls and sticks)."""
+    from a URDF is drawn with its visual meshes, at most ``max_triangles`` triangles together
+    (default: :data:`amble.viz.meshes.MAX_TRIANGLES` in the ``.html`` viewer,
+    :data:`amble.viz.movie.MOVIE_TRIANGLES` in a movie; 0: balls and sticks)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".html":
@@ -243,5 +260,6 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
         check_writer(path)
         system = traj.system
         slope = _slope(system, traj.parameters) if isinstance(system, Walker) else None
-        return write_movie(traj, path, fps, look_of(system, traj.parameters, look), slope, progress=progress)
+        shapes, solids = movie_look(traj, path, fps, look, max_triangles)
+        return write_movie(traj, path, fps, shapes, slope, progress=progress, solids=solids)
     raise VizError(f"unknown animation format {path.suffix!r}: use .html, .gif or .mp4")
