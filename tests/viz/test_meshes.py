@@ -214,25 +214,80 @@ def test_a_large_robot_is_reduced_to_the_budget():
         np.testing.assert_allclose(b.vertices.max(axis=0), a.vertices.max(axis=0), atol=0.01)
 
 
-@pytest.mark.browser
-@needs_chromium
-def test_bolts_meshes_are_drawn_in_frame(bolt_run, tmp_path):
-    scene = scene_of(bolt_run, fps=30, series=[])
+def _standing(system, srdf: Path, state: str) -> np.ndarray:
+    """The state at rest in a configuration of the robot's SRDF (``group_state``), read here
+    with the standard library: coordinates by joint name, zero velocities."""
+    import xml.etree.ElementTree as ET
+
+    group = next(g for g in ET.parse(srdf).getroot().iter("group_state") if g.get("name") == state)
+    values = {j.get("name"): j.get("value") for j in group.iter("joint")}
+    names = [str(q) for q in system.modes[system.name].q]
+    x0 = np.zeros(2 * len(names))
+    x0[: len(names)] = [float(values.get(n, 0.0)) for n in names]
+    assert sum(n in values for n in names) >= 0.9 * len(names)   # Talos: not its 2 grippers
+    return x0
+
+
+def _screenshot(scene: dict, tmp_path: Path, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """The page of ``scene`` in headless Chromium at time ``t`` (s), bare (``ui=0``), with the
+    meshes painted red and the floor green: the masks of mesh and of floor pixels."""
     for s in scene["shapes"]:
         if s["type"] == "mesh":
             s["color"] = [0.9, 0.1, 0.1]   # red: told apart from the floor and the sky
-    path = write_html(tmp_path / "bolt.html", scene)
-    png = tmp_path / "bolt.png"
-    _finish(_chromium(f"{path.as_uri()}#t=0.2&ui=0", f"--window-size={WIDTH},{HEIGHT}",
+        elif s["type"] == "ground":
+            s["color"] = [0.1, 0.7, 0.2]
+    path = write_html(tmp_path / "robot.html", scene)
+    png = tmp_path / "robot.png"
+    _finish(_chromium(f"{path.as_uri()}#t={t}&ui=0", f"--window-size={WIDTH},{HEIGHT}",
                       "--virtual-time-budget=2000", f"--screenshot={png}", profile=tmp_path / "p"))
     img = _read_png(png)
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
     red = (r > 60) & (r > 1.8 * g) & (r > 1.8 * b)
-    assert red.sum() > 3000, f"only {red.sum()} pixels of mesh"
+    green = (g > 60) & (g > 1.5 * r) & (g > 1.5 * b)
+    return red, green
+
+
+def _whole_in_frame(red: np.ndarray, green: np.ndarray, least: int) -> None:
+    """The robot's pixels: many, clear of every border, not a speck; the floor's too."""
+    assert red.sum() > least, f"only {red.sum()} pixels of mesh"
     rows, cols = np.nonzero(red)
-    # in frame: clear of every border, and not a speck
-    assert rows.min() > 10 and cols.min() > 10 and rows.max() < HEIGHT - 10 and cols.max() < WIDTH - 10
+    assert rows.min() > 10 and cols.min() > 10 and rows.max() < HEIGHT - 10 and cols.max() < WIDTH - 10, \
+        f"mesh pixels reach the border: rows {rows.min()}..{rows.max()}, columns {cols.min()}..{cols.max()}"
     assert rows.max() - rows.min() > HEIGHT / 5
+    assert green.sum() > 0.05 * HEIGHT * WIDTH, f"only {green.sum()} pixels of floor"
+    # the floor is seen under the robot: floor pixels below its lowest mesh pixel
+    assert green[rows.max() + 1:].sum() > 1000
+
+
+@pytest.mark.browser
+@needs_chromium
+def test_bolts_meshes_are_drawn_in_frame(bolt_run, tmp_path):
+    red, green = _screenshot(scene_of(bolt_run, fps=30, series=[]), tmp_path, 0.2)
+    _whole_in_frame(red, green, 3000)
+
+
+ROBOT_SHOTS = [
+    pytest.param("solo_description/robots/solo12.urdf", "solo.srdf", "standing", id="solo12"),
+    pytest.param("talos_data/robots/talos_reduced.urdf", "talos.srdf", "half_sitting", id="talos",
+                 marks=pytest.mark.slow),    # 32 coordinates: compiling its kernels takes about 30 s
+]
+
+
+@pytest.mark.browser
+@needs_chromium
+@pytest.mark.parametrize(("urdf", "srdf", "state"), ROBOT_SHOTS)
+def test_a_robot_standing_is_drawn_whole_over_its_floor(urdf, srdf, state, tmp_path):
+    """Solo12 and Talos in a standing configuration of their SRDF, fixed at the base: the
+    scene of a short run is built as for any user (meshes from the URDF, poses by the link
+    kinematics) and shown at its start."""
+    path = ROBOTS / urdf
+    system = load_robot(path, fixed_base=True)
+    x0 = _standing(system, path.parents[1] / "srdf" / srdf, state)
+    run = simulate(system, x0, t_end=0.05)
+    scene = scene_of(run, fps=30, series=[])
+    assert len([s for s in scene["shapes"] if s["type"] == "mesh"]) == len(urdf_visuals(path))
+    red, green = _screenshot(scene, tmp_path, 0.0)
+    _whole_in_frame(red, green, 3000)
 
 
 def _mjcf(tmp_path: Path) -> Path:

@@ -93,6 +93,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     out_p = writable_path(args.out, (".csv", ".parquet", ".npz"), "--out")
     plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    series = _series(args.series, anim_p)
     if anim_p:  # an MP4 without ffmpeg is refused before any work
         from ..viz.movie import check_writer
 
@@ -130,7 +131,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         write_output(plot_p, lambda part: plot_trajectory(tr, part), "--plot")
         summary["plot"] = str(plot_p)
     if anim_p:
-        _animate(tr, anim_p)
+        _animate(tr, anim_p, series)
         summary["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {tr.status} — {tr.message}")
@@ -143,7 +144,32 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     return summary
 
 
-def _animate(tr: Any, path: Any) -> None:
+def _series(values: list[str] | None, anim_p: Any) -> Any:
+    """The ``series`` of the viewer from ``--series`` options: ``None`` (the default panels),
+    ``[]`` for ``none``, a list of names (one panel per unit), or panel title → names when every
+    option reads ``TITLE=NAME,...``."""
+    if not values:
+        return None
+    if anim_p is None or anim_p.suffix.lower() != ".html":
+        raise UsageError("--series needs --animate FILE.html (the viewer's time-series plot)")
+    if [v.strip().lower() for v in values] == ["none"]:
+        return []
+    panels: dict[str, list[str]] = {}
+    names: list[str] = []
+    for v in values:
+        title, sep, rest = v.partition("=") if "=" in v else ("", "", v)
+        parts = [n.strip() for n in rest.split(",") if n.strip()]
+        if not parts or (sep and not title.strip()):
+            raise UsageError(f"--series expects 'NAME,NAME,...' or 'TITLE=NAME,...', got {v!r}")
+        if sep:
+            panels.setdefault(title.strip(), []).extend(parts)
+        names += parts
+    if 0 < sum("=" in v for v in values) < len(values):
+        raise UsageError("--series: give every panel a title (TITLE=NAME,...) or none")
+    return panels or names
+
+
+def _animate(tr: Any, path: Any, series: Any = None) -> None:
     """Write the animation of ``tr``: a GIF or MP4 is written atomically by the movie writer itself
     (its messages name the file), an HTML page through a part file."""
     from ..viz.animate import animate
@@ -151,7 +177,7 @@ def _animate(tr: Any, path: Any) -> None:
     if path.suffix.lower() in (".gif", ".mp4"):
         animate(tr, path)
     else:
-        write_output(path, lambda part: animate(tr, part), "--animate")
+        write_output(path, lambda part: animate(tr, part, series=series), "--animate")
 
 
 def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
@@ -159,6 +185,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
 
     plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
     anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    series = _series(args.series, anim_p)
     if anim_p:  # an MP4 without ffmpeg is refused before any work
         from ..viz.movie import check_writer
 
@@ -193,7 +220,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
             write_output(plot_p, lambda part: plot_limit_cycle(tr, part, cycle=lc), "--plot")
             out["plot"] = str(plot_p)
         if anim_p:
-            _animate(tr, anim_p)
+            _animate(tr, anim_p, series)
             out["animation"] = str(anim_p)
     if not args.json:
         unit = s.time_unit
@@ -231,6 +258,9 @@ def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------- parser
+SERIES_HELP = ("with --animate FILE.html: the time series plotted under the 3D view, NAME,NAME,... (names "
+               "of one unit share a panel) or TITLE=NAME,... (one titled panel each; repeatable); names: "
+               "state variables and 'energy'; 'none' for no plot (default: the coordinates and the energy)")
 EXAMPLES = {
     "models": "amble models --json",
     "equations": "amble equations compass-gait --latex",
@@ -329,6 +359,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
+    s.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
     s.add_argument("--method", choices=METHODS, default="dop853",
                    help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
                         "tsit5 (explicit, 5th order)")
@@ -343,6 +374,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
+    lc.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
     lc.set_defaults(func=cmd_limit_cycle)
     sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
                       "on local worker processes or Dask")

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..errors import AmbleError
 from ..modelling.hybrid import HybridSystem
 from ..modelling.walker import Walker
 from ..simulation.trajectory import Trajectory
@@ -102,11 +103,72 @@ def _slope(system: HybridSystem, params: dict[str, float]) -> float:
     return system.slope_value(params) if isinstance(system, Walker) else 0.0
 
 
-def series_of(traj: Trajectory, times: np.ndarray, names: Sequence[str] | None) -> dict[str, np.ndarray]:
+#: A panel title for the quantity a unit measures (the unit itself if not listed).
+QUANTITIES = {"rad": "angle", "deg": "angle", "rad/s": "angular velocity", "m": "position",
+              "m/s": "velocity", "J": "energy", "N·m": "torque", "N*m": "torque", "N": "force",
+              "W": "power", "s": "time"}
+
+#: The ``series`` argument: names (grouped by unit), or panel title → names, or ``None``.
+SeriesSpec = Sequence[str] | Mapping[str, Sequence[str]] | None
+
+
+def _series_unit(traj: Trajectory, name: str) -> str:
+    """The unit of a series (``""`` if undeclared or unknown: :func:`series_of` rejects the latter)."""
+    try:
+        return traj.unit("kinetic_energy" if name == "energy" else name)
+    except AmbleError:
+        return ""
+
+
+def series_groups(traj: Trajectory, series: SeriesSpec) -> list[dict[str, Any]]:
+    """The panels of the viewer's time-series plot: ``[{"title", "unit", "series": [names],
+    "units": [each series' unit]}]``.
+
+    ``series`` is a mapping of panel title → names (one panel each, in order, e.g.
+    ``{"left leg": ["q1", "q2"], "right leg": ["q3", "q4"]}``), or a list of names, which share a
+    panel when they share a unit (``"rad"``: titled ``"angle"``, ``"J"``: ``"energy"``, …; a name
+    without a unit gets a panel of its own), or ``None``: the coordinates of the first mode and
+    ``"energy"``. A panel's ``unit`` is its series' common unit (``""`` if they differ)."""
+    if series is None:
+        series = [*(str(q) for q in traj.system.modes[traj.mode_names[0]].q), "energy"]
+    if isinstance(series, str):
+        series = [series]
+    if isinstance(series, Mapping):
+        groups = []
+        for title, names in series.items():
+            names = [names] if isinstance(names, str) else [str(n) for n in names]
+            if not names:
+                raise SceneError(f"series: panel {title!r} names no series")
+            units = {_series_unit(traj, n) for n in names}
+            groups.append({"title": str(title), "unit": units.pop() if len(units) == 1 else "",
+                           "series": names, "units": [_series_unit(traj, n) for n in names]})
+        return groups
+    by_unit: dict[str, dict[str, Any]] = {}
+    out: list[dict[str, Any]] = []
+    for name in (str(n) for n in series):
+        unit = _series_unit(traj, name)
+        if unit and unit in by_unit:
+            by_unit[unit]["series"].append(name)
+            by_unit[unit]["units"].append(unit)
+            continue
+        group = {"title": QUANTITIES.get(unit, unit) if unit else name, "unit": unit, "series": [name],
+                 "units": [unit]}
+        out.append(group)
+        if unit:
+            by_unit[unit] = group
+    return out
+
+
+def series_of(traj: Trajectory, times: np.ndarray, names: SeriesSpec) -> dict[str, np.ndarray]:
     """Values at ``times`` of state variables by name and ``"energy"`` (total), for the viewer's
-    panel; default: the coordinates of the first mode and the energy."""
+    panel; default: the coordinates of the first mode and the energy. ``names`` may also be a
+    mapping of panel title → names (see :func:`series_groups`)."""
     if names is None:
         names = [*(str(q) for q in traj.system.modes[traj.mode_names[0]].q), "energy"]
+    if isinstance(names, str):
+        names = [names]
+    if isinstance(names, Mapping):
+        names = [n for group in series_groups(traj, names) for n in group["series"]]
     table = traj.table()
     out = {}
     for name in names:
@@ -122,9 +184,9 @@ def series_of(traj: Trajectory, times: np.ndarray, names: Sequence[str] | None) 
 
 
 def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = None,
-             series: Sequence[str] | None = None, max_triangles: int | None = None) -> dict:
+             series: SeriesSpec = None, max_triangles: int | None = None) -> dict:
     """Scene JSON (see :func:`amble.viz.scene.frames`) of a trajectory in world coordinates, with
-    a time-series panel of ``series`` (see :func:`series_of`; ``[]`` for none). Without a
+    a time-series panel of ``series`` in panels (see :func:`series_groups`; ``[]`` for none). Without a
     ``look``, a robot read from a URDF is drawn with its visual meshes, at most ``max_triangles``
     triangles (default :data:`amble.viz.meshes.MAX_TRIANGLES`; 0 draws balls and sticks)."""
     from .meshes import MAX_TRIANGLES
@@ -148,12 +210,30 @@ def scene_of(traj: Trajectory, fps: float = 60.0, look: Sequence[Any] | None = N
     labels = {}
     if walker:  # a step count means something for a walker only
         labels["step"] = np.searchsorted([e.t for e in traj.step_events], times, side="right").tolist()
-    return frames(shapes, pts, times, follow=follow, labels=labels, series=series_of(traj, times, series),
-                  poses=poses, meshes=meshes)
+    values = series_of(traj, times, series)
+    groups = series_groups(traj, series) if values else None
+    return frames(shapes, pts, times, follow=follow, labels=labels, series=values, series_groups=groups,
+                  time_unit=system.time_unit, poses=poses, meshes=meshes)
+
+
+def movie_look(traj: Trajectory, path: str | Path, fps: float, look: Sequence[Any] | None = None,
+               max_triangles: int | None = None) -> tuple[list[Any], Any]:
+    """The shapes of a movie of ``traj`` and, for a robot read from a URDF or MJCF file (without
+    a ``look``), the poses and meshes of its visuals at the movie's frames (at most
+    ``max_triangles`` triangles, default :data:`amble.viz.movie.MOVIE_TRIANGLES`; 0: balls and
+    sticks), for :func:`amble.viz.movie.write_movie`."""
+    from .movie import MOVIE_TRIANGLES, movie_times
+
+    shapes = look_of(traj.system, traj.parameters, look)
+    budget = MOVIE_TRIANGLES if max_triangles is None else int(max_triangles)
+    if look or budget <= 0:
+        return shapes, None
+    shapes, poses, meshes, _ = with_meshes(traj, movie_times(traj, path, fps), shapes, budget)
+    return shapes, ((poses, meshes) if meshes else None)
 
 
 def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequence[Any] | None = None,
-            progress: bool | None = None, series: Sequence[str] | None = None,
+            progress: bool | None = None, series: SeriesSpec = None,
             max_triangles: int | None = None) -> Path:
     """Write an animation of ``traj``: ``.html`` (3D, offline, interactive), ``.gif`` or ``.mp4``.
 
@@ -161,10 +241,13 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
     plays in the trajectory's time with a clock, at most 30 fps (a GIF at a rate whose frames last
     whole hundredths of a second: 25 fps for 30); ``progress``: a progress bar while a movie is
     written (default: when stderr is a terminal). See :mod:`amble.viz.movie`. ``series``: state
-    variables (and ``"energy"``) shown as time series under the 3D view of the ``.html`` viewer,
-    with a playhead (default: the coordinates and the energy; ``[]`` for no panel). A robot read
-    from a URDF is drawn in the ``.html`` viewer with its visual meshes, at most ``max_triangles``
-    triangles together (default :data:`amble.viz.meshes.MAX_TRIANGLES`; 0: balls and sticks)."""
+    variables (and ``"energy"``) plotted under the 3D view of the ``.html`` viewer, with
+    labelled axes, a legend and a playhead showing the current values: a list of names (those of
+    one unit share a panel) or a mapping panel title → names (see :func:`series_groups`; default:
+    the coordinates and the energy; ``[]`` for no panel). A robot read
+    from a URDF is drawn with its visual meshes, at most ``max_triangles`` triangles together
+    (default: :data:`amble.viz.meshes.MAX_TRIANGLES` in the ``.html`` viewer,
+    :data:`amble.viz.movie.MOVIE_TRIANGLES` in a movie; 0: balls and sticks)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".html":
@@ -177,5 +260,6 @@ def animate(traj: Trajectory, path: str | Path, fps: float = 60.0, look: Sequenc
         check_writer(path)
         system = traj.system
         slope = _slope(system, traj.parameters) if isinstance(system, Walker) else None
-        return write_movie(traj, path, fps, look_of(system, traj.parameters, look), slope, progress=progress)
+        shapes, solids = movie_look(traj, path, fps, look, max_triangles)
+        return write_movie(traj, path, fps, shapes, slope, progress=progress, solids=solids)
     raise VizError(f"unknown animation format {path.suffix!r}: use .html, .gif or .mp4")

@@ -25,6 +25,8 @@ def frames(
     follow: str | None = None,
     labels: Mapping[str, Sequence[Any]] | None = None,
     series: Mapping[str, Sequence[float]] | None = None,
+    series_groups: Sequence[Mapping[str, Any]] | None = None,
+    time_unit: str = "s",
     poses: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
     meshes: Mapping[str, dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
@@ -42,6 +44,10 @@ def frames(
             ``{"step": step_index}``; each a sequence of ``F`` numbers or strings.
         series: time series drawn in the viewer's panel with a playhead, e.g.
             ``{"stance": values, "energy": values}``; each ``F`` numbers.
+        series_groups: the panels of that plot, in order: ``{"title": str, "unit": str,
+            "series": [names], "units": [str]}`` each (``units``, one per series, optional; default:
+            one panel per series, titled by its name).
+        time_unit: the unit of ``times`` shown on the plot's time axis.
         poses: frames that :class:`Mesh` shapes are fixed to, by name: positions ``(F, 3)`` in
             metres and rotations ``(F, 3, 3)`` (the frame's axes as columns, world coordinates).
         meshes: triangles of the :class:`Mesh` shapes by key, as :func:`amble.viz.meshes.encode`
@@ -115,7 +121,8 @@ def frames(
         "shapes": shape_dicts,
         "follow": follow,
         "labels": _labels(labels, n),
-        **({"series": _series(series, n)} if series else {}),
+        **({"series": _series(series, n), "series_groups": _groups(series, series_groups),
+            "time_unit": str(time_unit)} if series else {}),
         **pose_data,
         "bounds": {"min": _flat(lo), "max": _flat(hi)},
         "size": rounded(size),
@@ -190,6 +197,26 @@ def _series(series: Mapping[str, Sequence[float]], n: int) -> dict[str, list[Any
         if vals.shape != (n,):
             raise SceneError(f"frames: series {key!r} has shape {vals.shape}, times has {n}")
         out[str(key)] = [rounded(float(v)) if math.isfinite(v) else None for v in vals]
+    return out
+
+
+def _groups(series: Mapping[str, Sequence[float]], groups: Sequence[Mapping[str, Any]] | None
+            ) -> list[dict[str, Any]]:
+    """The panels of the time-series plot, each naming series that are given."""
+    if groups is None:
+        return [{"title": str(k), "unit": "", "series": [str(k)], "units": [""]} for k in series]
+    out = []
+    for g in groups:
+        names = [str(k) for k in g.get("series", ())]
+        missing = [k for k in names if k not in series]
+        if missing or not names:
+            raise SceneError(f"frames: series panel {g.get('title')!r} names "
+                             + (f"unknown series {', '.join(map(repr, missing))}" if missing else "no series"))
+        units = [str(u or "") for u in g.get("units") or [g.get("unit")] * len(names)]
+        if len(units) != len(names):
+            raise SceneError(f"frames: series panel {g.get('title')!r} has {len(units)} units for {len(names)} series")
+        out.append({"title": str(g.get("title", names[0])), "unit": str(g.get("unit") or ""), "series": names,
+                    "units": units})
     return out
 
 

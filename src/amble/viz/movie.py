@@ -30,6 +30,8 @@ from ..simulation.trajectory import Trajectory
 from .errors import ExportError
 
 MAX_FPS = 30.0
+#: At most this many triangles of a robot file's meshes are drawn in a movie (together).
+MOVIE_TRIANGLES = 4000
 
 
 def movie_fps(path: str | Path, fps: float) -> float:
@@ -64,12 +66,14 @@ def check_writer(path: str | Path) -> None:
 
 
 def write_movie(traj: Trajectory, path: Path, fps: float, shapes: Sequence[Any], slope: float | None,
-                progress: bool | None = None) -> Path:
+                progress: bool | None = None, solids: Solids | None = None) -> Path:
+    """Write the movie of ``traj`` (see the module docstring); ``solids``: the poses and meshes
+    of the :class:`~amble.viz.scene.Mesh` shapes at the movie's frames (:func:`movie_times`)."""
     from tqdm.auto import tqdm
 
     check_writer(path)
     fps = movie_fps(path, fps)
-    mf = movie_figure(traj, fps, shapes, slope)
+    mf = movie_figure(traj, fps, shapes, slope, solids)
     frames = _frames(mf)
     part = path.with_name(f".{path.stem}.part{path.suffix}")
     bar = tqdm(total=len(mf.times), desc=f"writing {path.name}", unit="frame",
@@ -107,10 +111,64 @@ class MovieFigure:
     update: Callable[[int], None]
 
 
-def movie_figure(traj: Trajectory, fps: float, shapes: Sequence[Any], slope: float | None) -> MovieFigure:
-    """A side view (and a front view for a 3D model) of the links and balls of ``shapes``, with
-    a walker's ground and a clock, sampled at ``fps``; the moving artists are marked animated."""
+#: The poses (frame → positions ``(F, 3)``, rotations ``(F, 3, 3)``) and the encoded meshes (key →
+#: :func:`amble.viz.meshes.encode`) of a movie's :class:`~amble.viz.scene.Mesh` shapes.
+Solids = tuple[dict[str, tuple[np.ndarray, np.ndarray]], dict[str, dict[str, Any]]]
+
+
+def movie_times(traj: Trajectory, path: str | Path, fps: float) -> np.ndarray:
+    """The times (s) of a movie's frames at the asked ``fps`` (see :func:`movie_fps`)."""
+    return traj.resample(movie_fps(path, fps))[0]
+
+
+class _Solids:
+    """The triangles of the meshes, posed per frame and drawn in each view as flat-shaded
+    polygons, the farthest first (an orthographic painter's algorithm)."""
+
+    def __init__(self, shapes: Sequence[Any], solids: Solids | None) -> None:
+        from .meshes import decode
+        from .scene import Mesh
+
+        self.parts = []
+        poses, meshes = solids or ({}, {})
+        for s in shapes:
+            if isinstance(s, Mesh):
+                v, f = decode(meshes[s.mesh])
+                self.parts.append((v, f, np.asarray(s.color, float), *poses[s.frame]))
+
+    def extent(self) -> np.ndarray:
+        """Every posed vertex of every frame, ``(n, 3)`` (for the axis limits)."""
+        if not self.parts:
+            return np.zeros((0, 3))
+        return np.concatenate([(v @ np.swapaxes(R, 1, 2) + p[:, None, :]).reshape(-1, 3)
+                               for v, _, _, p, R in self.parts])
+
+    def triangles(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """The world triangles ``(n, 3, 3)`` at frame ``k`` and their colours ``(n, 3)``."""
+        tri = [(v @ R[k].T + p[k])[f] for v, f, _, p, R in self.parts]
+        col = [np.broadcast_to(c, (len(f), 3)) for _, f, c, _, _ in self.parts]
+        return np.concatenate(tri), np.concatenate(col)
+
+    @staticmethod
+    def project(tri: np.ndarray, col: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+        """The polygons of view ``(i, j)`` (the axes across and up; the view looks along their
+        cross product) in drawing order, and their shaded colours."""
+        depth_axis = 3 - i - j
+        toward = -1.0 if (i, j) == (0, 2) else 1.0      # side: seen from -y; front: from +x
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        facing = np.abs(n[:, depth_axis]) / np.maximum(np.linalg.norm(n, axis=1), 1e-300)
+        order = np.argsort(toward * tri[:, :, depth_axis].mean(axis=1))   # far first
+        shade = (0.35 + 0.65 * facing)[order, None]
+        return tri[order][:, :, [i, j]], np.clip(col[order] * shade, 0.0, 1.0)
+
+
+def movie_figure(traj: Trajectory, fps: float, shapes: Sequence[Any], slope: float | None,
+                 solids: Solids | None = None) -> MovieFigure:
+    """A side view (and a front view for a 3D model) of the links, balls and meshes of
+    ``shapes``, with a walker's ground and a clock, sampled at ``fps``; the moving artists are
+    marked animated. ``solids``: the poses and meshes of the ``Mesh`` shapes at those samples."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.collections import PolyCollection
     from matplotlib.figure import Figure
 
     from .scene import Cylinder, Sphere
@@ -119,11 +177,12 @@ def movie_figure(traj: Trajectory, fps: float, shapes: Sequence[Any], slope: flo
     times, pts = traj.resample(fps)
     links = [s for s in shapes if isinstance(s, Cylinder)]
     balls = [s for s in shapes if isinstance(s, Sphere)]
+    solid = _Solids(shapes, solids)
     views = [(0, 2, "side (x–z)")] + ([(1, 2, "front (y–z)")] if system.dims == 3 else [])
     fig = Figure(figsize=(5 * len(views), 4))
     canvas = FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(views), squeeze=False)
-    allp = np.concatenate([np.nan_to_num(v) for v in pts.values()])
+    allp = np.concatenate([np.nan_to_num(v) for v in pts.values()] + [solid.extent()])
     clock = fig.text(0.01, 0.97, "", ha="left", va="top", family="monospace", animated=True)
     moving: list[tuple[int, int, list[Any], list[Any]]] = []
     for ax, (i, j, title) in zip(axes[0], views):
@@ -139,12 +198,20 @@ def movie_figure(traj: Trajectory, fps: float, shapes: Sequence[Any], slope: flo
             ax.set_ylim(lo[j], hi[j])
         lines = [ax.plot([], [], "-", color="0.4", lw=2, animated=True)[0] for _ in links]
         dots = [ax.plot([], [], "o", color=s.color, ms=4 + 60 * s.radius, animated=True)[0] for s in balls]
+        if solid.parts:   # not antialiased: no seams between the triangles
+            lines.insert(0, ax.add_collection(PolyCollection([], linewidths=0, antialiased=False, animated=True)))
         moving.append((i, j, lines, dots))
     unit = system.time_unit
 
     def update(f: int) -> None:
         clock.set_text(f"t = {times[f]:.2f} {unit}")
+        posed = solid.triangles(f) if solid.parts else None
         for i, j, lines, dots in moving:
+            if posed is not None:
+                polys, colours = solid.project(*posed, i, j)
+                lines[0].set_verts(polys)
+                lines[0].set_facecolor(colours)
+                lines = lines[1:]
             for ln, s in zip(lines, links):
                 a, b = pts[s.between[0]][f], pts[s.between[1]][f]
                 ln.set_data([a[i], b[i]], [a[j], b[j]])

@@ -36,6 +36,11 @@ Scene format (``"format": "amble.scene/1"``)
                              "lo": [x, y, z], "step": [dx, dy, dz], "triangles": n}},
       "follow": "hip" | null,                   # point the camera may track
       "labels": {"step": [0, 0, 1, ...]},        # F values per label (numbers or strings)
+      "series": {"stance": [...], "energy": [...]},  # F numbers (or null) per time series
+      "series_groups": [{"title": "angle", "unit": "rad", "series": ["stance", "swing"],
+                         "units": ["rad", "rad"]}, ...],
+                                                # the panels of the time-series plot, in order
+      "time_unit": "s",                         # the unit of "times" on the plot's time axis
       "bounds": {"min": [x, y, z], "max": [x, y, z]}, # over all exported points and frames
       "size": d                                 # the robot's extent: largest bounding-box
                                                 # diagonal of one frame, metres
@@ -45,6 +50,9 @@ Scene format (``"format": "amble.scene/1"``)
 axis for the little-endian uint16 triples ``k`` of ``positions``, ``indices`` holds uint16 (uint32
 when ``wide``) triangles, both base64 (see :mod:`amble.viz.meshes`); the bounds and ``size``
 include the meshes' bounding boxes.
+
+``series``, ``series_groups`` and ``time_unit`` are present when there is a time-series plot
+(a scene without ``series_groups`` is shown with one panel per series).
 
 Only points referenced by a shape (or by ``follow``) are exported. Numbers are
 rounded to 1e-5, which is far below what a screen can show and keeps a 20 s,
