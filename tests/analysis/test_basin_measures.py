@@ -19,14 +19,16 @@ from amble.cli.main import main
 G, L, ALPHA, SLOPE = 9.81, 1.0, math.pi / 8, 0.08
 
 
-def test_the_rimless_wheels_boundary_along_its_speed_is_the_speed_that_just_carries_it_over_the_top():
+@pytest.mark.parametrize("criterion", ["converge", "walk"])
+def test_the_rimless_wheels_boundary_along_its_speed_is_the_speed_that_just_carries_it_over_the_top(criterion):
     s = load_model("rimless-wheel", derivatives=True)
     s.max_step_time = 60.0  # a step just over the top takes long; the model's 5 s would count it a fall
     lc = find_fixed_point(s)
-    b = basin_measures(lc, samples=0, reach=0.5, xtol=1e-9, rtol=1e-10, atol=1e-10)
+    b = basin_measures(lc, samples=0, reach=0.5, xtol=1e-9, rtol=1e-10, atol=1e-10, criterion=criterion)
     # after an impact the stance spoke is at gamma - alpha: the hub passes over the top iff
     # w^2 > 2 (g/l)(1 - cos(gamma - alpha)) (energy); every faster wheel converges to the gait
     # (the energy map e' = cos^2(2 alpha) e + phi is a contraction), every slower one rocks back
+    # and never steps again: returning to the gait and walking on have the same boundary
     w_fix = 1 / math.tan(2 * ALPHA) * math.sqrt(4 * G / L * math.sin(ALPHA) * math.sin(SLOPE))
     w_top = math.sqrt(2 * G / L * (1 - math.cos(SLOPE - ALPHA)))
     up, down = b.distances
