@@ -32,8 +32,8 @@ def test_the_rimless_wheels_boundary_along_its_speed_is_the_speed_that_just_carr
     w_fix = 1 / math.tan(2 * ALPHA) * math.sqrt(4 * G / L * math.sin(ALPHA) * math.sin(SLOPE))
     w_top = math.sqrt(2 * G / L * (1 - math.cos(SLOPE - ALPHA)))
     up, down = b.distances
-    assert up["name"] == "+theta_dot" and up["distance"] is None and up["outside"] is None
-    assert down["name"] == "-theta_dot"
+    assert up["name"] == "+theta_dot" and up["distance"] is None and up["outside"] is None and up["reason"] == ""
+    assert down["name"] == "-theta_dot" and down["reason"] != ""
     assert down["inside"] <= w_fix - w_top + 1e-10 and down["outside"] >= w_fix - w_top - 1e-10
     assert down["distance"] == pytest.approx(w_fix - w_top, abs=2e-9)
     assert b.section_coordinates == ["theta_dot"]
@@ -90,6 +90,9 @@ def test_a_direction_over_a_tied_coordinate_moves_its_partner_on_the_section():
     a = basin_measures(lc, [{"swing": -1.0}, {"stance": 1.0}], samples=0, xtol=1e-6).distances
     # stance + swing = 2 slope on the section: lowering the swing angle raises the stance angle
     assert a[0]["distance"] == pytest.approx(a[1]["distance"], abs=2e-6)
+    # the walks shared by two threads give the same answers
+    b = basin_measures(lc, [{"swing": -1.0}, {"stance": 1.0}], samples=0, xtol=1e-6, threads=2).distances
+    assert a == b
 
 
 @pytest.mark.parametrize("kw, what", [

@@ -61,7 +61,9 @@ class BasinMeasures:
     ``distances``: per direction, ``name`` (``"+swing_dot"``, or ``"d1"``… for given ones),
     ``direction`` (unit vector, name → component), ``distance`` (``None`` beyond ``reach``),
     ``inside`` and ``outside`` (the bracket: the farthest perturbation found inside and the nearest
-    found outside, ``None`` when there is none), ``reach``. ``size``: ``fraction``, ``ci_low``,
+    found outside, ``None`` when there is none), ``reason`` (why that nearest outside state is outside:
+    ``"off the section"``, ``"not converged"`` — it kept walking elsewhere —, or how its walk
+    ended, e.g. ``"fell"``; ``""`` when none was found), ``reach``. ``size``: ``fraction``, ``ci_low``,
     ``ci_high``, ``confidence``, ``samples``, ``inside``, ``box`` (name → [low, high]) and
     ``volume``; ``None`` when no samples were drawn.
     """
@@ -106,11 +108,14 @@ class _Judge:
             keep.append(j)
         return self.section.coordinates(prefer=keep)
 
-    def inside(self, raw: np.ndarray, S: np.ndarray) -> np.ndarray:
-        """Whether each row of ``raw`` (states, its coordinates ``S`` kept) is inside the basin."""
+    def inside(self, raw: np.ndarray, S: np.ndarray) -> tuple[np.ndarray, list[str]]:
+        """Whether each row of ``raw`` (states, its coordinates ``S`` kept) is inside the basin,
+        and why each one outside is (``"off the section"``, ``"not converged"`` or the walk's status,
+        e.g. ``"fell"``; ``""`` inside)."""
         x, off = self.section.project_array(raw, S, threads=self.threads)
         ok = ~off & np.isfinite(x).all(axis=1)
         res = np.zeros(len(raw), dtype=bool)
+        why = ["off the section"] * len(raw)
         if ok.any():
             converge = self.criterion == "converge"
             w = walk_many(self.k, self.p, self.mode, x[ok], self.xs, steps=self.steps,
@@ -118,7 +123,9 @@ class _Judge:
                           threads=self.threads)
             done = w["code"] == CODE["STEPS_DONE"]
             res[ok] = done & (w["distance"] < self.tol) if converge else done
-        return res
+            for r, st, d, i in zip(np.flatnonzero(ok).tolist(), w["status"], done.tolist(), res[ok].tolist()):
+                why[r] = "" if i else "not converged" if d else st
+        return res, why
 
 
 def _unit(direction: Mapping[str, float], names: Sequence[str]) -> np.ndarray:
@@ -134,36 +141,39 @@ def _unit(direction: Mapping[str, float], names: Sequence[str]) -> np.ndarray:
 
 
 def _distances(judge: _Judge, dirs: list[np.ndarray], charts: list[np.ndarray], reach: float, scan: int,
-               xtol: float) -> tuple[np.ndarray, np.ndarray]:
-    """The bracket (last inside, first outside) of every direction's first boundary crossing;
-    first outside ``inf`` when none is found up to ``reach``."""
+               xtol: float) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """The bracket (last inside, first outside) of every direction's first boundary crossing,
+    first outside ``inf`` when none is found up to ``reach``, and why the first outside is."""
     m = len(dirs)
     lo, hi = np.zeros(m), np.full(m, math.inf)
+    why = [""] * m
 
-    def judge_points(rows: list[tuple[int, float]]) -> np.ndarray:
+    def judge_points(rows: list[tuple[int, float]]) -> tuple[np.ndarray, list[str]]:
         raw = np.array([judge.xs + s * dirs[j] for j, s in rows])
-        res = np.zeros(len(rows), dtype=bool)
+        res, reasons = np.zeros(len(rows), dtype=bool), [""] * len(rows)
         groups: dict[bytes, list[int]] = {}
         for r, (j, _) in enumerate(rows):
             groups.setdefault(charts[j].tobytes(), []).append(r)
         for idx in groups.values():  # one compiled call per chart (the default directions: one per coordinate)
-            res[idx] = judge.inside(raw[idx], charts[rows[idx[0]][0]])
-        return res
+            res[idx], got = judge.inside(raw[idx], charts[rows[idx[0]][0]])
+            for r, w in zip(idx, got):
+                reasons[r] = w
+        return res, reasons
 
     def narrow(points: dict[int, np.ndarray]) -> None:
         rows = [(j, float(s)) for j, ss in points.items() for s in ss]
-        res = judge_points(rows)
+        res, reasons = judge_points(rows)
         at = 0
         for j, ss in points.items():
             ins = res[at : at + len(ss)]
-            at += len(ss)
             out = np.flatnonzero(~ins)
             if out.size:
-                hi[j] = ss[out[0]]
+                hi[j], why[j] = ss[out[0]], reasons[at + int(out[0])]
                 if out[0] > 0:
                     lo[j] = ss[out[0] - 1]
             else:
                 lo[j] = ss[-1]
+            at += len(ss)
 
     narrow({j: reach * np.arange(1, scan + 1) / scan for j in range(m)})
     for _ in range(200):
@@ -171,7 +181,7 @@ def _distances(judge: _Judge, dirs: list[np.ndarray], charts: list[np.ndarray], 
         if not open_:
             break
         narrow({j: lo[j] + (hi[j] - lo[j]) * np.arange(1, SPLIT) / SPLIT for j in open_})
-    return lo, hi
+    return lo, hi, why
 
 
 def _size(judge: _Judge, S: np.ndarray, half: np.ndarray, samples: int, seed: int, confidence: float
@@ -181,7 +191,7 @@ def _size(judge: _Judge, S: np.ndarray, half: np.ndarray, samples: int, seed: in
     rng = np.random.default_rng(seed)
     raw = np.tile(judge.xs, (samples, 1))
     raw[:, S] += rng.uniform(-1.0, 1.0, (samples, len(S))) * half
-    n_in = int(judge.inside(raw, S).sum())
+    n_in = int(judge.inside(raw, S)[0].sum())
     ci = binomtest(n_in, samples).proportion_ci(confidence_level=confidence, method="exact")
     frac = n_in / samples
     box = {judge.names[i]: [float(judge.xs[i] - h), float(judge.xs[i] + h)] for i, h in zip(S.tolist(), half)}
@@ -234,13 +244,13 @@ def basin_measures(cycle: LimitCycle, directions: Sequence[Mapping[str, float]] 
         labelled = [(f"d{j + 1}", dict(d)) for j, d in enumerate(directions)]
     dirs = [_unit(d, names) for _, d in labelled]
     charts = [judge.chart(d) for d in dirs]
-    lo, hi = _distances(judge, dirs, charts, float(reach), scan, float(xtol)) if dirs else (np.zeros(0),) * 2
+    lo, hi, why = _distances(judge, dirs, charts, float(reach), scan, float(xtol)) if dirs else ([], [], [])
     dist = []
-    for (name, _), d, a, b in zip(labelled, dirs, lo, hi):
+    for (name, _), d, a, b, reason in zip(labelled, dirs, lo, hi, why):
         found = math.isfinite(b)
         dist.append({"name": name, "direction": {names[i]: float(d[i]) for i in np.flatnonzero(d).tolist()},
                      "distance": float(0.5 * (a + b)) if found else None, "inside": float(a),
-                     "outside": float(b) if found else None, "reach": float(reach)})
+                     "outside": float(b) if found else None, "reason": reason, "reach": float(reach)})
     size = None
     if isinstance(box, Mapping):
         stray = [nm for nm in box if nm not in [names[i] for i in S.tolist()]]

@@ -61,20 +61,24 @@ def cmd_robustness(args: argparse.Namespace) -> dict[str, Any]:
     lc = find_fixed_point(system, params=parse_sets(args.set))
     g = gait_sensitivity(lc, args.param)
     out = g.to_json()
+    b = None if args.no_basin else basin_measures(
+        lc, dirs, steps=args.steps, criterion=args.criterion, reach=args.reach, samples=args.samples, box=args.box,
+        seed=args.seed, threads=args.threads)
+    if b is not None:
+        out["basin"] = b.to_json()
     if not args.json:
         print(f"{system.name}: gait sensitivity norm for one step's {args.param}: step time {g.step_time:.4g}, "
               f"post-impact state {g.state:.4g} (per unit of {args.param}; {g.steps} steps summed)")
-    if args.no_basin:
-        return out
-    b = basin_measures(lc, dirs, steps=args.steps, criterion=args.criterion, reach=args.reach, samples=args.samples,
-                       box=args.box, seed=args.seed, threads=args.threads)
-    out["basin"] = b.to_json()
-    if not args.json:
-        for d in b.distances:
-            far = f"{d['distance']:.6g}" if d["distance"] is not None else f"beyond {d['reach']:g}"
-            print(f"  distance to the basin's boundary along {d['name']}: {far}")
-        if b.size is not None:
-            s = b.size
-            print(f"  share of the box in the basin: {s['fraction']:.3f} ({s['ci_low']:.3f}-{s['ci_high']:.3f}, "
-                  f"{s['samples']} samples)")
+        if b is not None:
+            _print_basin(b)
     return out
+
+
+def _print_basin(b: Any) -> None:
+    for d in b.distances:
+        far = f"{d['distance']:.6g} ({d['reason']})" if d["distance"] is not None else f"beyond {d['reach']:g}"
+        print(f"  distance to the basin's boundary along {d['name']}: {far}")
+    if b.size is not None:
+        s = b.size
+        print(f"  share of the box in the basin: {s['fraction']:.3f} ({s['ci_low']:.3f}-{s['ci_high']:.3f}, "
+              f"{s['samples']} samples)")
