@@ -130,3 +130,22 @@ def test_the_command_line_reports_the_basin_measures(capsys):
     assert "basin" not in json.loads(capsys.readouterr().out)
     assert main(["robustness", "rimless-wheel", "--param", "slope", "--direction", "theta_dot=x"]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+@pytest.mark.slow
+def test_the_compass_gaits_box_share_counts_the_states_goswamis_equations_return_from():
+    lc = find_fixed_point(load_model("compass-gait", derivatives=True))
+    half = {"stance": 0.02, "stance_dot": 0.08, "swing_dot": 0.5}
+    b = basin_measures(lc, [], samples=24, box=half, seed=5)
+    # the same draws (uniform in the box over the section coordinates, stance + swing = 2 slope)
+    rng = np.random.default_rng(5)
+    u = rng.uniform(-1.0, 1.0, (24, 3)) * np.array(list(half.values()))
+    x_fix = goswami_fixed_point(0.05)[0]
+    count = 0
+    for du in u:
+        x = lc.fixed_point.copy()
+        x[[0, 2, 3]] += du
+        x[1] = 2 * 0.05 - x[0]
+        count += _goswami_returns(x, x_fix)
+    assert b.section_coordinates == list(half) and 0 < count < 24
+    assert b.size["inside"] == count
