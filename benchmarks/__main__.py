@@ -1,6 +1,6 @@
 """Run the benchmark suite, print the tables and write ``BENCHMARKS.md``.
 
-Usage: ``python -m benchmarks [--quick] [--only derive,walk,startup,sweep,gaitopt,jacobian,tree,calls,movie]
+Usage: ``python -m benchmarks [--quick] [--only derive,walk,startup,sweep,gaitopt,jacobian,tree,calls,movie,mfpt]
 [--output PATH | --no-write]``.
 ``--quick`` shrinks every benchmark (fewer chain sizes, 20 walking steps) for a smoke run; the
 published numbers come from a full run.
@@ -21,7 +21,8 @@ from pathlib import Path
 
 from benchmarks.common import REPO_ROOT, Section, child_env, machine, table
 
-BENCHES: tuple[str, ...] = ("derive", "walk", "startup", "sweep", "gaitopt", "jacobian", "tree", "calls", "movie")
+BENCHES: tuple[str, ...] = ("derive", "walk", "startup", "sweep", "gaitopt", "jacobian", "tree", "calls", "movie",
+                             "mfpt")
 
 
 def _sweep(quick: bool) -> Section:

@@ -56,6 +56,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
     **dict.fromkeys(("MarkovPassage", "markov_mfpt"), ".analysis.markov"),
     **dict.fromkeys(("GaitSensitivity", "gait_sensitivity"), ".analysis.robustness"),
+    **dict.fromkeys(("BasinMeasures", "basin_measures"), ".analysis.basin_measures"),
     **dict.fromkeys(("MujocoReplay", "planar_biped_mjcf", "replay_in_mujoco"), ".analysis.mujoco_replay"),
     "gait_gradients": ".analysis.gait_gradients",
     "check_gait": ".analysis.gait_check",
