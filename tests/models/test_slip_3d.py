@@ -65,7 +65,15 @@ def test_symmetric_gait_and_multipliers_match_oracle(oracle_gait):
 
 def test_symmetric_gait_is_laterally_unstable_where_the_planar_slip_is_self_stable():
     planar_gait = amble.find_fixed_point(planar.build())  # same m, L0, k, alpha, g and energy
-    assert planar_gait.stable and abs(planar_gait.multipliers[0]) < 1
+    (mu_planar,) = planar_gait.multipliers
+    assert planar_gait.stable and abs(mu_planar) < 1
+    # with the leg straight ahead (beta = 0) the 3D gait is the planar one: the same apex and the
+    # planar runner's multiplier, and besides it a lateral one outside the unit circle
+    z, vx = planar_gait.fixed_point[1:3]
+    flat = amble.find_fixed_point(build(), [0.0, 0.0, z, vx, 0.0, 0.0], params={"beta": 0.0})
+    assert abs(flat.fixed_point[2] - z) <= 1e-9 and abs(flat.fixed_point[4]) <= 1e-12
+    small, large = sorted(flat.multipliers.real, key=abs)
+    assert abs(small - mu_planar.real) <= 1e-8 and large < -1.2
     for beta_deg in (1.0, 5.0, 10.0):
         o = Slip3D(beta=math.radians(beta_deg))
         p = o.fixed_point(guess=(0.94, 0.0083 * beta_deg))
@@ -78,3 +86,11 @@ def test_symmetric_gait_is_laterally_unstable_where_the_planar_slip_is_self_stab
         assert cyc.section_coordinates == ["x_dot", "y_dot"] and abs(vec[1, i]) > 0.99 * np.linalg.norm(vec[:, i])
         # the other multiplier is the apex-height mode the planar runner has, and stable
         assert abs(mu[1 - i]) < 1
+
+
+def test_leg_placed_relative_to_the_heading_leaves_the_lateral_mode_neutral():
+    # the docstring's contrast, in the independent runner: measured from the mass's heading, the
+    # placement is symmetric under rotations about the vertical, so the lateral multiplier is −1
+    o = Slip3D(placement="heading")
+    mu = o.multipliers(o.fixed_point(guess=(0.939, 0.045)))
+    assert abs(mu[0] + 1) <= 1e-6 and abs(mu[1]) < 1

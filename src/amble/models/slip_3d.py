@@ -59,7 +59,8 @@ it is self-stable) and −1.213 (lateral velocity: the sideways fall). The later
 near −1.21 as ``beta`` → 0: even the planar gait, run in three dimensions with its leg placed
 straight ahead, is laterally unstable. Placing the leg relative to the mass's heading instead
 would make the lateral multiplier exactly −1 (the model is symmetric under rotations about the
-vertical), neutral, not stable either.
+vertical), neutral, not stable either: "fixed touchdown angles" are read as fixed in the world
+frame, the rule under which the symmetric gaits are unstable as published.
 """
 
 from __future__ import annotations
