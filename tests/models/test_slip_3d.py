@@ -94,3 +94,23 @@ def test_leg_placed_relative_to_the_heading_leaves_the_lateral_mode_neutral():
     o = Slip3D(placement="heading")
     mu = o.multipliers(o.fixed_point(guess=(0.939, 0.045)))
     assert abs(mu[0] + 1) <= 1e-6 and abs(mu[1]) < 1
+
+
+# (leg stiffness N/m, angle of attack deg) across Seyfarth's self-stable band of the planar runner
+BAND = [(16000.0, 66.0), (20000.0, 67.0), (24000.0, 69.0), (24000.0, 70.0), (28000.0, 70.0)]
+
+
+@pytest.mark.parametrize(("k", "alpha_deg"), BAND)
+def test_lateral_instability_across_the_planar_self_stable_band(k, alpha_deg):
+    at = {"k": k, "alpha": math.radians(alpha_deg)}
+    planar_gait = amble.find_fixed_point(planar.build(), params=at)
+    assert planar_gait.stable
+    z, vx = planar_gait.fixed_point[1:3]
+    o = Slip3D(k=k, alpha=at["alpha"])
+    p = o.fixed_point(guess=(z, 0.04))
+    cyc = amble.find_fixed_point(build(), o.apex_state(*p), params=at)
+    assert np.max(np.abs(cyc.fixed_point - o.apex_state(*p))) <= 1e-8
+    mu = np.linalg.eigvals(cyc.jacobian)
+    ref = o.multipliers(p)
+    assert np.max(np.abs(np.sort_complex(mu) - np.sort_complex(ref))) <= 1e-5
+    assert min(mu.real) < -1.15 and not cyc.stable  # the sideways fall, in every case

@@ -57,7 +57,8 @@ At the defaults the symmetric gait has its apex at 0.939005 m with a lateral vel
 runner's mode: −0.161 for ``slip-runner`` at the same ``m, L0, k, alpha`` and energy, where
 it is self-stable) and −1.213 (lateral velocity: the sideways fall). The lateral multiplier stays
 near −1.21 as ``beta`` → 0: even the planar gait, run in three dimensions with its leg placed
-straight ahead, is laterally unstable. Placing the leg relative to the mass's heading instead
+straight ahead, is laterally unstable; across the planar runner's self-stable band (16 kN/m at 66°
+to 28 kN/m at 70°) it lies between −1.17 and −1.31. Placing the leg relative to the mass's heading instead
 would make the lateral multiplier exactly −1 (the model is symmetric under rotations about the
 vertical), neutral, not stable either: "fixed touchdown angles" are read as fixed in the world
 frame, the rule under which the symmetric gaits are unstable as published.
