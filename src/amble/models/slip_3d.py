@@ -54,14 +54,14 @@ name       default     unit   meaning
 
 At the defaults the symmetric gait has its apex at 0.939005 m with a lateral velocity of
 0.04163 m/s towards the stance foot; its multipliers are −0.224 (apex height, the planar
-runner's mode: −0.161 for ``slip-runner`` at the same ``m, L0, k, alpha`` and energy, where
-it is self-stable) and −1.213 (lateral velocity: the sideways fall). The lateral multiplier stays
-near −1.21 as ``beta`` → 0: even the planar gait, run in three dimensions with its leg placed
-straight ahead, is laterally unstable; across the planar runner's self-stable band (16 kN/m at 66°
-to 28 kN/m at 70°) it lies between −1.17 and −1.31. Placing the leg relative to the mass's heading instead
-would make the lateral multiplier exactly −1 (the model is symmetric under rotations about the
-vertical), neutral, not stable either: "fixed touchdown angles" are read as fixed in the world
-frame, the rule under which the symmetric gaits are unstable as published.
+runner's mode) and −1.213 (lateral velocity: the sideways fall). With ``beta = 0`` the gait is
+``slip-runner``'s, with its multiplier −0.161 (self-stable) and besides it a lateral −1.211: even
+the planar gait, run in three dimensions with its leg placed straight ahead, is laterally
+unstable. Across the planar runner's self-stable band (16 kN/m at 66° to 28 kN/m at 70°) the
+lateral multiplier lies between −1.17 and −1.31. Placing the leg relative to the mass's heading
+instead would make the lateral multiplier exactly −1 (the model is then symmetric under rotations
+about the vertical): neutral, not stable either. "Fixed touchdown angles" are read here as fixed
+in the world frame, the rule under which the symmetric gaits are unstable as published.
 """
 
 from __future__ import annotations
