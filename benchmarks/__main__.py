@@ -22,7 +22,7 @@ from pathlib import Path
 from benchmarks.common import REPO_ROOT, Section, child_env, machine, table
 
 BENCHES: tuple[str, ...] = ("derive", "walk", "startup", "sweep", "gaitopt", "jacobian", "tree", "calls", "movie",
-                             "mfpt")
+                             "mfpt", "thesis3d")
 
 
 def _sweep(quick: bool) -> Section:
