@@ -69,3 +69,54 @@ def test_the_command_line_reports_the_norm_and_refuses_an_unknown_parameter(caps
     assert d["gsn_state"] >= d["gsn_coordinates"]["theta_dot"] > 0 and d["gsn_step_time"] > 0
     assert main(["robustness", "rimless-wheel", "--param", "mu"]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def _compass_with_a_step():
+    """The library's compass gait whose footfall meets ground ``step`` (m) above the stance foot's
+    slope plane: a parameter that disturbs one step as a step up or down."""
+    from amble import walker
+    from amble.models import compass_gait
+
+    m = compass_gait.model()
+    st, sw = m.q
+    step = m.parameter("step", 0.0, "height of the ground the swing foot meets", "m")
+    return walker(m, foot="swing_foot", hip="hip", slope=m.symbol("slope"), relabel={st: sw, sw: st},
+                  start=[-0.2168, 0.3168, 1.0839, 0.3981], step_height=step)
+
+
+def test_a_step_lands_the_foot_on_ground_that_high():
+    """One step onto ground 2 cm lower: the swing foot strikes where its height above the slope
+    plane is −0.02 m, and the walk goes on from the new stance foot."""
+    from amble import simulate
+
+    s = _compass_with_a_step()
+    lc = find_fixed_point(s)
+    run = simulate(s, lc.fixed_point, params={**lc.parameters, "step": -0.02}, steps=1)
+    x = run.events[0].x_pre  # the state at the footfall, before the impact
+    st, sw, a, b, gamma = x[0], x[1], 0.5, 0.5, lc.parameters["slope"]
+    foot = (a + b) * np.array([np.sin(st) - np.sin(sw), np.cos(st) - np.cos(sw)])  # (x, z) of the swing foot
+    normal = np.array([np.sin(gamma), np.cos(gamma)])  # the slope descends along +x
+    assert float(foot @ normal) == pytest.approx(-0.02, abs=1e-10)
+
+
+def test_the_compass_gaits_norm_for_a_step_down_is_that_of_disturbed_walks():
+    """Hobbelen & Wisse's disturbance: one step onto ground ±δ high, then level walking again."""
+    s = _compass_with_a_step()
+    lc = find_fixed_point(s)
+    g = gait_sensitivity(lc, "step")
+    d = 1e-6
+    P = ReturnMap(s, lc.parameters)
+    resp = {}
+    for sign in (1, -1):
+        x, t = ReturnMap(s, {**lc.parameters, "step": sign * d})(lc.fixed_point)
+        xs, ts = [x], [t]
+        for _ in range(g.steps):
+            x, t = P(x)
+            xs.append(x)
+            ts.append(t)
+        resp[sign] = np.array(xs), np.array(ts)
+    dx = (resp[1][0] - resp[-1][0]) / (2 * d)
+    dt = (resp[1][1] - resp[-1][1]) / (2 * d)
+    assert g.state == pytest.approx(math.sqrt(float(np.sum(dx**2))), rel=1e-4)
+    assert g.step_time == pytest.approx(math.sqrt(float(np.sum(dt**2))), rel=1e-4)
+    assert g.state > 1.0  # a centimetre's step moves the gait by centimetres: not a vanishing response

@@ -87,6 +87,7 @@ def walker(
     doc: str = "",
     margin: Any = None,
     stance: str | RoundFoot | None = None,
+    step_height: Any = 0,
 ) -> Walker:
     """A one-mode walker: heel strike of ``foot`` on the slope (a step) and a fall of ``hip``.
 
@@ -94,11 +95,13 @@ def walker(
     ``model.state_names`` order). A walker that makes no footfall for ``max_step_time`` seconds,
     or whose hip reaches the ground, has fallen. ``mirror``: see :class:`Walker`; ``margin``:
     the footfall's enabling margin, and ``stance`` the stance foot the swing ``foot`` must be ahead
-    of (needed with round feet, whose stance contact moves), see :func:`heel_strike`.
+    of (needed with round feet, whose stance contact moves), and ``step_height`` the height of
+    the ground the foot meets above the stance foot's slope plane (e.g. a parameter ``step``, 0 by
+    default, to disturb one step), see :func:`heel_strike`.
     """
     sys_ = Walker(model.name, {model.name: model}, max_step_time=max_step_time, hip=hip, slope=slope,
                   mirror=mirror, doc=doc)
-    guard, reset = heel_strike(model, foot, slope, relabel, margin, stance)
+    guard, reset = heel_strike(model, foot, slope, relabel, margin, stance, step_height)
     sys_.transition("heel_strike", model.name, guard, reset, step=True)
     sys_.terminal("hip_on_ground", model.name, Guard(height_above_slope(model, hip, slope), -1), status="fell")
     if start is not None:

@@ -14,6 +14,7 @@ from typing import Any
 
 import sympy as sp
 
+from ..expressions import checked_expr
 from ..model import Model
 from ..transitions import Guard, Impact
 from .ground import distance_along_slope, height_above_slope
@@ -37,7 +38,8 @@ def _contact_point(foot: str | RoundFoot) -> str:
 
 
 def heel_strike(model: Model, foot: str | RoundFoot, slope: Any, relabel: Mapping[Any, Any],
-                margin: Any = None, stance: str | RoundFoot | None = None) -> tuple[Guard, Impact]:
+                margin: Any = None, stance: str | RoundFoot | None = None,
+                step_height: Any = 0) -> tuple[Guard, Impact]:
     """Guard and reset of a footfall: ``foot`` reaches the slope while ahead of the stance foot
     by more than ``margin`` (default :data:`STEP_MARGIN` × :func:`model_size`, so that legs
     passing each other — the foot at the stance foot up to round-off — are no footfall),
@@ -47,7 +49,10 @@ def heel_strike(model: Model, foot: str | RoundFoot, slope: Any, relabel: Mappin
     point meets the slope and the impact constrains the material point of the foot at the
     contact (its ``rolling`` point, which also becomes the next step's origin). ``stance``
     names the stance foot's contact (a point or a ``RoundFoot``) that the foot must be ahead
-    of; by default the origin, where a point stance foot stands.
+    of; by default the origin, where a point stance foot stands. ``step_height`` (m, along the
+    slope's normal): the ground the foot meets lies this far above the stance foot's slope plane
+    — a step up if positive, down if negative; with a parameter, one step's terrain disturbance
+    (the next step's ground is again the plane through the new stance foot).
     """
     contact = _contact_point(foot)
     if margin is None:
@@ -57,5 +62,6 @@ def heel_strike(model: Model, foot: str | RoundFoot, slope: Any, relabel: Mappin
         ahead -= distance_along_slope(model, _contact_point(stance), slope)
     # unevaluated: deciding ``ahead > margin`` asks sympy for signs of the whole expression, which
     # for a rigid-body tree's positions (shared graphs) takes minutes; the compiled code decides it
-    guard = Guard(height_above_slope(model, contact, slope), -1, sp.StrictGreaterThan(ahead, margin, evaluate=False))
+    height = height_above_slope(model, contact, slope) - checked_expr(model, step_height, "step height")
+    guard = Guard(height, -1, sp.StrictGreaterThan(ahead, margin, evaluate=False))
     return guard, Impact(foot.rolling if isinstance(foot, RoundFoot) else foot, relabel)
