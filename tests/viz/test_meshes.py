@@ -268,8 +268,8 @@ def test_bolts_meshes_are_drawn_in_frame(bolt_run, tmp_path):
 
 ROBOT_SHOTS = [
     pytest.param("solo_description/robots/solo12.urdf", "solo.srdf", "standing", id="solo12"),
-    pytest.param("talos_data/robots/talos_reduced.urdf", "talos.srdf", "half_sitting", id="talos",
-                 marks=pytest.mark.slow),    # 32 coordinates: compiling its kernels takes about 30 s
+    # 32 coordinates: compiling its kernels takes about 30 s from a cold cache (once per machine)
+    pytest.param("talos_data/robots/talos_reduced.urdf", "talos.srdf", "half_sitting", id="talos"),
 ]
 
 
