@@ -23,6 +23,7 @@ from dataclasses import replace
 import sympy as sp
 
 from ..derivation.impact import impulse_data
+from ..errors import ModelError
 from ..modelling.hybrid import target_exprs
 from ..modelling.model import Model, t
 from .codegen_support import ModeInfo, symbol_names
@@ -204,7 +205,12 @@ _SIGNATURES = (
 def derivative_kernels(modes: dict[str, ModeInfo], order: list, trs_by_mode: dict[str, list],
                        switches: dict[str, list[sp.Expr]], params: list[str]) -> str:
     """All derivative kernels of a system and their dispatchers (``rhs_jac``, ``rhs_jacp``,
-    ``surfaces_grad``, ``reset_jac``)."""
+    ``surfaces_grad``, ``reset_jac``). A mode with holonomic constraints is refused: its flow
+    Jacobian would need the tangent of the constrained solve, which is not generated."""
+    for name, mi in modes.items():
+        if mi.equations.holonomic is not None:
+            raise ModelError(f"mode {name!r} has holonomic constraints: exact sensitivities, flow Jacobians and "
+                             "the implicit integrator are not available for it")
     kernels = []
     for name, mi in modes.items():
         nm = symbol_names(mi.model, params)

@@ -1,0 +1,122 @@
+"""Holonomic constraints inside a mode (``Model.holonomic``): a planar four-bar linkage written as
+three free rods whose loop is closed by two constraint equations, against an independent
+one-degree-of-freedom solution (tests/oracles/four_bar.py: closed-form kinematics, Lagrange's
+equation in the crank angle, solve_ivp) and an independent KKT solve for the constraint forces."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from amble import HybridSystem, Model, compiled, simulate
+from amble.errors import ExpressionError, ModelError
+from tests.oracles import four_bar as fb
+
+TH1, W1 = 0.3, 2.0  # start: crank angle (rad) and rate (rad/s); the crank turns over once in 3 s
+
+
+def four_bar(baumgarte: tuple[float, float] | None = None) -> HybridSystem:
+    m = Model("four-bar")
+    th1, th2, th3 = m.coordinates("theta1 theta2 theta3")
+    a, b, c, d = m.parameters(a=fb.LINKS["a"], b=fb.LINKS["b"], c=fb.LINKS["c"], d=fb.LINKS["d"])
+    m1, m2, m3, g = m.parameters(**fb.MASSES, g=fb.G)
+    u = lambda x: sp.Matrix([sp.cos(x), sp.sin(x)])  # noqa: E731
+    tip = m.point("B", a * u(th1))
+    m.point("crank", a / 2 * u(th1), mass=m1)
+    m.point("coupler", tip + b / 2 * u(th2), mass=m2)
+    m.point("rocker", sp.Matrix([d, 0]) + c / 2 * u(th3), mass=m3)
+    for angle, mass, length in ((th1, m1, a), (th2, m2, b), (th3, m3, c)):
+        m.inertia(angle, mass * length**2 / 12)
+    m.gravity(g)
+    # the closure as text, read by the safe parser in the model's names
+    m.holonomic("loop", ["a*cos(theta1) + b*cos(theta2) - d - c*cos(theta3)",
+                         "a*sin(theta1) + b*sin(theta2) - c*sin(theta3)"], baumgarte=baumgarte)
+    return HybridSystem("four-bar", m)
+
+
+@pytest.fixture(scope="module")
+def system() -> HybridSystem:
+    return four_bar()
+
+
+def _params(k) -> np.ndarray:
+    return np.array(k.meta["param_defaults"], dtype=float)
+
+
+def test_four_bar_follows_its_reduced_dynamics(system):
+    x0 = fb.state(TH1, W1)
+    traj = simulate(system, x0, t_end=3.0, rtol=1e-13, atol=1e-13, sample_dt=0.01)
+    assert traj.status == "end_time"
+    ref = fb.reduced_motion(TH1, W1, traj.t)
+    assert np.ptp(traj.x[:, 0]) > 4.0  # the crank turns over: not a small swing
+    assert np.max(np.abs(traj.x[:, 0] - ref[:, 0])) <= 1e-8
+    assert np.max(np.abs(traj.x[:, 3] - ref[:, 1])) <= 1e-8
+    # the closure does no work: K + V (amble's, and the oracle's of amble's states) is conserved
+    E = traj.energy().sum(axis=1)
+    assert np.ptp(E) / abs(E[0]) <= 1e-9
+    E_ref = np.array([fb.energy(x) for x in traj.x])
+    assert np.max(np.abs(E - E_ref)) <= 1e-9 * abs(E_ref[0])
+    drift = np.max(np.abs([fb.closure(x) for x in traj.x]))  # |φ| without stabilisation
+    assert drift <= 1e-10, drift
+
+
+def test_constraint_forces_match_an_independent_kkt_solve(system):
+    k = compiled(system)
+    assert k.constraint_names("four-bar") == ["loop[0]", "loop[1]"]
+    p = _params(k)
+    rng = np.random.default_rng(3)
+    X = np.array([fb.state(th, w) for th, w in zip(rng.uniform(-np.pi, np.pi, 8), rng.uniform(-3, 3, 8))])
+    lam = k.constraint_forces_many("four-bar", 0.0, X, p)
+    for x, lx in zip(X, lam):
+        qdd, lam_ref = fb.kkt(x)
+        np.testing.assert_allclose(lx, lam_ref, rtol=1e-11, atol=1e-11)
+        np.testing.assert_allclose(k.rhs("four-bar", 0.0, x, p)[3:], qdd, rtol=1e-11, atol=1e-11)
+    np.testing.assert_array_equal(k.constraint_forces("four-bar", 0.0, X[0], p), lam[0])
+
+
+def test_baumgarte_pulls_a_violated_start_back():
+    x0 = fb.state(TH1, W1)
+    x0[1] += 1e-3  # the loop open by about 1 mm
+    free = simulate(four_bar(), x0, t_end=2.0, sample_dt=0.01)
+    held = simulate(four_bar((10.0, 10.0)), x0, t_end=2.0, sample_dt=0.01)
+    assert np.max(np.abs(fb.closure(free.x[-1]))) > 1e-4  # without feedback the error stays
+    assert np.max(np.abs(fb.closure(held.x[-1]))) < 1e-8
+
+
+def test_sensitivities_of_a_constrained_mode_are_refused(system):
+    with pytest.raises(ModelError, match="mode 'four-bar' has holonomic constraints"):
+        compiled(system, derivatives=True)
+
+
+def test_declaration_errors():
+    m = Model("bad")
+    x, z = m.coordinates("x z", unit="m")
+    m.point("p", (x, z), mass=1.0)
+    with pytest.raises(ModelError, match="not on time"):
+        m.holonomic("moving", [x - sp.Symbol("t", real=True)])
+    with pytest.raises(ModelError, match="neither a coordinate nor a parameter"):
+        m.holonomic("unknown", [x - sp.Symbol("w")])
+    with pytest.raises(ExpressionError):
+        m.holonomic("text", ["__import__('os')"])
+    with pytest.raises(ModelError, match="baumgarte"):
+        m.holonomic("gains", [x], baumgarte=(1.0, -1.0))
+    m.holonomic("floor", "z")
+    with pytest.raises(ModelError, match="already declared"):
+        m.holonomic("floor", [z])
+    assert m.constraint_names == ["floor"]
+
+
+def test_a_held_point_mass_pushes_on_its_support():
+    """A point mass held at height 0 by one constraint: λ is the support's force, m g, upward."""
+    m = Model("held")
+    x, z = m.coordinates("x z", unit="m")
+    mass, g = m.parameters(mass=2.0, g=9.81)
+    m.point("p", (x, z), mass=mass)
+    m.gravity(g)
+    m.holonomic("floor", [z])
+    k = compiled(HybridSystem("held", m))
+    lam = k.constraint_forces("held", 0.0, np.array([0.0, 0.0, 1.5, 0.0]), np.array([2.0, 9.81]))
+    np.testing.assert_allclose(lam, [2.0 * 9.81], rtol=1e-14)
+    np.testing.assert_allclose(k.rhs("held", 0.0, np.array([0.0, 0.0, 1.5, 0.0]), np.array([2.0, 9.81])),
+                               [1.5, 0.0, 0.0, 0.0], atol=1e-14)
