@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from amble import HybridSystem, Model, compiled, simulate
+from amble import HybridSystem, Model, compiled, linearize, simulate
 from amble.errors import ExpressionError, ModelError
 from tests.oracles import four_bar as fb
 
@@ -87,6 +87,8 @@ def test_baumgarte_pulls_a_violated_start_back():
 def test_sensitivities_of_a_constrained_mode_are_refused(system):
     with pytest.raises(ModelError, match="mode 'four-bar' has holonomic constraints"):
         compiled(system, derivatives=True)
+    with pytest.raises(ModelError, match="mode 'four-bar' has holonomic constraints"):
+        linearize(system, fb.state(TH1, W1))
 
 
 def test_declaration_errors():

@@ -131,7 +131,8 @@ def closure(x: np.ndarray, links: dict = LINKS) -> np.ndarray:
     """``f(θ)``, the loop-closure residual (m)."""
     a, b, c, d = links["a"], links["b"], links["c"], links["d"]
     t1, t2, t3 = x[:3]
-    return np.array([a * np.cos(t1) + b * np.cos(t2) - d - c * np.cos(t3), a * np.sin(t1) + b * np.sin(t2) - c * np.sin(t3)])
+    return np.array([a * np.cos(t1) + b * np.cos(t2) - d - c * np.cos(t3),
+                     a * np.sin(t1) + b * np.sin(t2) - c * np.sin(t3)])
 
 
 def kkt(x: np.ndarray, links: dict = LINKS, masses: dict = MASSES) -> tuple[np.ndarray, np.ndarray]:

@@ -31,11 +31,13 @@ from ..modelling.hybrid import Explicit, HybridSystem, Transition
 from ..modelling.model import Model
 from ..modelling.text import expr_of
 from .equations import derive
+from .holonomic import refuse_constrained
 
 
 def contact_force(model: Model, gap: Any) -> sp.Expr:
     """The multiplier ``λ(q, q̇, t)`` (N per unit of ``∂φ/∂q``; N for a gap in metres along a
     unit normal) that holds ``φ(q, t) = 0`` on ``model`` (see the module docstring)."""
+    refuse_constrained(model, "contact_force")
     eq = derive(model)
     J, w = _jacobian_and_w(model, gap)
     phid = _normal_velocity(model, gap)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..errors import ModelError
 from ..modelling.model import Model
 
 
@@ -53,3 +54,11 @@ def holonomic_terms(model: Model) -> Holonomic | None:
         alpha, beta = gains[i]
         gamma[i] = -acc - (2 * sp.Float(alpha) * v[i] if alpha else 0) - (sp.Float(beta) ** 2 * phi[i] if beta else 0)
     return Holonomic(names=model.constraint_names, phi=sp.Matrix(phi), J=J, gamma=gamma)
+
+
+def refuse_constrained(model: Model, what: str) -> None:
+    """A :class:`ModelError` naming the mode if it has holonomic constraints: ``what`` (a
+    computation written for ``M q̈ + h = Γ`` alone) would ignore them and give wrong numbers."""
+    if model.holonomic_constraints:
+        raise ModelError(f"mode {model.name!r} has holonomic constraints ({', '.join(model.holonomic_constraints)}): "
+                         f"{what} does not take them into account")
