@@ -324,4 +324,34 @@ static int amble_holonomic_solve(int n, int m, double *M, const double *J, const
     return 0;
 }
 
+/* The tangent of amble_holonomic_solve in nv directions: with L the Cholesky factor of M that it
+ * left, solve M a = R1 + Jᵀ l, J a = R2 (R1 n × nv, R2 m × nv, row-major); R1 is overwritten by a
+ * (the tangents of q̈), R2 by l (those of λ). */
+static int amble_holonomic_tangent(int n, int m, int nv, const double *L, const double *J, double *R1, double *R2) {
+    double XJ[n * m], S[m * m];
+    for (int i = 0; i < n; ++i)
+        for (int c = 0; c < m; ++c) XJ[i * m + c] = J[c * n + i];
+    amble_chol_apply_rows(n, L, XJ, m);
+    for (int a = 0; a < m; ++a)
+        for (int b = 0; b < m; ++b) {
+            double s = 0.0;
+            for (int i = 0; i < n; ++i) s += J[a * n + i] * XJ[i * m + b];
+            S[a * m + b] = s;
+        }
+    if (amble_chol_factor(m, S)) return AMBLE_ERR_SINGULAR_MASS;
+    amble_chol_apply_rows(n, L, R1, nv);
+    for (int c = 0; c < m; ++c)
+        for (int i = 0; i < n; ++i) {
+            const double j = J[c * n + i];
+            for (int v = 0; v < nv; ++v) R2[c * nv + v] -= j * R1[i * nv + v];
+        }
+    amble_chol_apply_rows(m, S, R2, nv);
+    for (int i = 0; i < n; ++i)
+        for (int c = 0; c < m; ++c) {
+            const double x = XJ[i * m + c];
+            for (int v = 0; v < nv; ++v) R1[i * nv + v] += x * R2[c * nv + v];
+        }
+    return 0;
+}
+
 #endif
