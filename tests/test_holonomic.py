@@ -8,11 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from oracles import four_bar as fb
 
 from amble import HybridSystem, Model, compiled, linearize, simulate
 from amble.errors import ExpressionError, ModelError
 from amble.simulation.engine import Options, run
-from tests.oracles import four_bar as fb
 
 TH1, W1 = 0.3, 2.0  # start: crank angle (rad) and rate (rad/s); the crank turns over once in 3 s
 
