@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 from oracles import four_bar as fb
 
-from amble import HybridSystem, Model, compiled, linearize, simulate
+from amble import HybridSystem, Joint, Model, compiled, linearize, simulate
 from amble.errors import ExpressionError, ModelError
 from amble.simulation.engine import Options, run
 
@@ -60,6 +60,39 @@ def test_four_bar_follows_its_reduced_dynamics(system):
     assert np.max(np.abs(E - E_ref)) <= 1e-9 * abs(E_ref[0])
     drift = np.max(np.abs([fb.closure(x) for x in traj.x]))  # |φ| without stabilisation
     assert drift <= 1e-10, drift
+
+
+def test_a_rigid_body_tree_closes_its_loop_between_two_bodies():
+    """The same linkage as a rigid-body tree (two branches from the base: crank then coupler, and
+    the rocker; relative joint angles) closed by the coupler's end meeting the rocker's."""
+    m = Model("four-bar-tree", dims=3)
+    m.gravity(fb.G)
+    T = m.rigid_tree()
+    L, Ms = fb.LINKS, fb.MASSES
+    ax = (0, -1, 0)  # about −y: a positive angle turns +x towards +z, as in the oracle
+
+    def rod(mass: float, length: float) -> dict:
+        return dict(mass=mass, com=(length / 2, 0, 0), inertia=np.diag([0.0, 1.0, 1.0]) * mass * length**2 / 12)
+
+    T.body("crank", joint=Joint("revolute", axis=ax), coordinate="q1", **rod(Ms["m1"], L["a"]))
+    T.body("coupler", parent="crank", joint=Joint("revolute", axis=ax, xyz=(L["a"], 0, 0)), coordinate="q2",
+           **rod(Ms["m2"], L["b"]))
+    T.body("rocker", joint=Joint("revolute", axis=ax, xyz=(L["d"], 0, 0)), coordinate="q3", **rod(Ms["m3"], L["c"]))
+    c1, c2 = T.point("C", "coupler", (L["b"], 0, 0)), T.point("C'", "rocker", (L["c"], 0, 0))
+    m.holonomic("loop", [c1[0] - c2[0], c1[2] - c2[2]])
+    system = HybridSystem("four-bar-tree", m)
+    th = fb.state(TH1, W1)
+    relative = np.array([[1, 0, 0], [-1, 1, 0], [0, 0, 1]])  # (θ1, θ2, θ3) → (q1, q2 = θ2 − θ1, q3)
+    x0 = np.concatenate([relative @ th[:3], relative @ th[3:]])
+    traj = simulate(system, x0, t_end=3.0, rtol=1e-13, atol=1e-13, sample_dt=0.01)
+    ref = fb.reduced_motion(TH1, W1, traj.t)
+    assert np.max(np.abs(traj.x[:, 0] - ref[:, 0])) <= 1e-8
+    absolute = np.linalg.inv(relative)
+    full = np.column_stack([traj.x[:, :3] @ absolute.T, traj.x[:, 3:] @ absolute.T])
+    k = compiled(system)
+    lam = k.constraint_forces_many(0, traj.t, traj.x, _params(k))
+    np.testing.assert_allclose(lam, [fb.kkt(x)[1] for x in full],
+                               atol=1e-9)
 
 
 def test_constraint_forces_match_an_independent_kkt_solve(system):
