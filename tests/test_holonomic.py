@@ -95,6 +95,43 @@ def test_a_rigid_body_tree_closes_its_loop_between_two_bodies():
                                atol=1e-9)
 
 
+def _four_bar_mjcf(th: tuple[float, float, float]) -> str:
+    """The linkage as MJCF, posed closed at the angles ``th`` (the file's pose: coordinates zero)."""
+    L, Ms = fb.LINKS, fb.MASSES
+
+    def inertial(mass: float, length: float) -> str:
+        moment = mass * length**2 / 12
+        return f'<inertial pos="{length / 2!r} 0 0" mass="{mass!r}" diaginertia="1e-6 {moment!r} {moment!r}"/>'
+
+    hinge = 'type="hinge" axis="0 -1 0"'
+    return f"""<mujoco model="four-bar"><compiler angle="radian"/><option gravity="0 0 -{fb.G!r}"/><worldbody>
+  <body name="crank" euler="0 {-th[0]!r} 0"><joint name="q1" {hinge}/>{inertial(Ms["m1"], L["a"])}
+    <body name="coupler" pos="{L["a"]!r} 0 0" euler="0 {th[0] - th[1]!r} 0"><joint name="q2" {hinge}/>
+      {inertial(Ms["m2"], L["b"])}</body></body>
+  <body name="rocker" pos="{L["d"]!r} 0 0" euler="0 {-th[2]!r} 0"><joint name="q3" {hinge}/>
+    {inertial(Ms["m3"], L["c"])}</body>
+</worldbody><equality><connect name="loop" body1="coupler" body2="rocker" anchor="{L["b"]!r} 0 0"/></equality>
+</mujoco>"""
+
+
+def test_an_mjcf_connect_closes_the_loop_of_a_file(tmp_path):
+    """``<equality><connect>`` of two bodies is read as a holonomic constraint (the component
+    normal to the planar loop, which no joint moves, left out)."""
+    pytest.importorskip("mujoco")
+    th = fb.state(TH1, W1)
+    path = tmp_path / "four_bar.xml"
+    path.write_text(_four_bar_mjcf(tuple(float(v) for v in th[:3])))
+    model = Model.from_mjcf(path)
+    assert model.constraint_names == ["loop[0]", "loop[1]"]
+    system = HybridSystem("four-bar-mjcf", model)
+    x0 = np.array([0.0, 0.0, 0.0, th[3], th[4] - th[3], th[5]])  # coordinates from the file's pose
+    traj = simulate(system, x0, t_end=3.0, rtol=1e-13, atol=1e-13, sample_dt=0.01)
+    ref = fb.reduced_motion(TH1, W1, traj.t)
+    assert np.max(np.abs(traj.x[:, 0] + TH1 - ref[:, 0])) <= 1e-8
+    E = traj.energy().sum(axis=1)
+    assert np.ptp(E) / abs(E[0]) <= 1e-9
+
+
 def test_constraint_forces_match_an_independent_kkt_solve(system):
     k = compiled(system)
     assert k.constraint_names("four-bar") == ["loop[0]", "loop[1]"]

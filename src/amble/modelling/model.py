@@ -365,7 +365,8 @@ class Model(Actuators):
         for e in exprs:
             self._check_symbols(e, f"holonomic constraint {name!r}")
             # rheonomic constraints (φ of t) would need ∂²φ/∂t² in γ: not supported
-            if t in e.free_symbols or not (e.free_symbols & set(self.q)):
+            syms = free_symbols(e)  # a tree's positions are shared graphs: each part visited once
+            if t in syms or not (syms & set(self.q)):
                 raise ModelError(f"model {self.name!r}: holonomic constraint {name!r}: {e} must depend on the "
                                  "coordinates and not on time")
         gains = (0.0, 0.0) if baumgarte is None else tuple(float(g) for g in baumgarte)
