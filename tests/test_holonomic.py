@@ -60,6 +60,10 @@ def test_four_bar_follows_its_reduced_dynamics(system):
     assert np.max(np.abs(E - E_ref)) <= 1e-9 * abs(E_ref[0])
     drift = np.max(np.abs([fb.closure(x) for x in traj.x]))  # |φ| without stabilisation
     assert drift <= 1e-10, drift
+    lam = traj.constraint_forces()  # per recorded row, by name
+    assert list(lam) == ["loop[0]", "loop[1]"]
+    np.testing.assert_allclose(np.column_stack([lam["loop[0]"], lam["loop[1]"]])[::25],
+                               [fb.kkt(x)[1] for x in traj.x[::25]], rtol=1e-10, atol=1e-10)
 
 
 def test_a_rigid_body_tree_closes_its_loop_between_two_bodies():
