@@ -221,3 +221,72 @@ def test_a_held_point_mass_pushes_on_its_support():
     np.testing.assert_allclose(lam, [2.0 * 9.81], rtol=1e-14)
     np.testing.assert_allclose(k.rhs("held", 0.0, np.array([0.0, 0.0, 1.5, 0.0]), np.array([2.0, 9.81])),
                                [1.5, 0.0, 0.0, 0.0], atol=1e-14)
+
+
+BIPED_MASSES = {"hip": 10.0, "head": 20.0, "left_thigh": 7.0, "right_thigh": 7.0, "left_shank": 3.0,
+                "right_shank": 3.0}
+STANCE = 0.25  # the feet are pinned at x = ∓STANCE on the ground (m)
+
+
+def double_support() -> HybridSystem:
+    """A planar five-link biped (hip position, torso and four absolute leg angles from the
+    vertical) with both feet held on the ground — two constraints of two equations each — and
+    a PD posture law at the hips and knees."""
+    m = Model("double-support")
+    x, z = m.coordinates("x z", unit="m")
+    torso, lt, ls, rt, rs = m.coordinates("torso left_thigh left_shank right_thigh right_shank")
+    ml, l_torso, l_thigh, l_shank, g, kp, kd = m.parameters(m_head=BIPED_MASSES["head"], l_torso=0.5, l_thigh=0.45,
+                                                            l_shank=0.45, g=9.81, kp=400.0, kd=40.0)
+    down = lambda a: sp.Matrix([sp.sin(a), -sp.cos(a)])  # noqa: E731
+    hip = m.point("hip", (x, z), mass=BIPED_MASSES["hip"])
+    m.point("head", hip - l_torso * down(torso), mass=ml)
+    for side, thigh, shank, at in (("left", lt, ls, -STANCE), ("right", rt, rs, STANCE)):
+        m.point(f"{side}_thigh", hip + l_thigh / 2 * down(thigh), mass=BIPED_MASSES[f"{side}_thigh"])
+        knee = hip + l_thigh * down(thigh)
+        m.point(f"{side}_shank", knee + l_shank / 2 * down(shank), mass=BIPED_MASSES[f"{side}_shank"])
+        foot = m.point(f"{side}_foot", knee + l_shank * down(shank))
+        m.holonomic(f"{side}_foot", [foot[0] - at, foot[1]])  # λ: the ground's force on the foot (x, z)
+    m.gravity(g)
+    laws = {}
+    for name, joint, ref in (("left_hip", lt - torso, -0.4), ("right_hip", rt - torso, 0.25),
+                             ("left_knee", ls - lt, 0.0), ("right_knee", rs - rt, 0.0)):
+        laws[m.actuator(name, joint)] = -kp * (joint - ref) - kd * m.dt(joint)
+    m.control(laws)
+    return HybridSystem("double-support", m)
+
+
+def test_a_biped_in_double_support_obeys_newton_for_its_whole_body():
+    """Along the motion the ground's forces (λ) and gravity accelerate the centre of mass:
+    ``Σλ + m g = Σ mᵢ aᵢ``, the accelerations taken from the recorded positions of the masses
+    (second differences, Richardson-extrapolated); at rest the feet carry the weight, with the
+    centre of pressure under the centre of mass."""
+    a = -0.35  # left thigh; the legs mirror each other and the torso leans 0.2 rad forward
+    b = np.arcsin((-STANCE - 0.45 * np.sin(a)) / 0.45)
+    x0 = np.array([0.0, 0.45 * (np.cos(a) + np.cos(b)), 0.2, a, b, -a, -b] + [0.0] * 7)
+    system = double_support()
+    dt = 5e-4
+    traj = simulate(system, x0, t_end=1.0, sample_dt=dt, rtol=1e-12, atol=1e-12)
+    pts, lam = traj.points(), traj.constraint_forces()
+    for side, at in (("left", -STANCE), ("right", STANCE)):
+        assert np.max(np.abs(pts[f"{side}_foot"][:, [0, 2]] - [at, 0.0])) <= 1e-10
+
+    def second_difference(step: int) -> np.ndarray:
+        n = len(traj.t)
+        return sum(mass * (p[2 + step:n - 2 + step] - 2 * p[2:n - 2] + p[2 - step:n - 2 - step]) / (step * dt) ** 2
+                   for p, mass in ((pts[k], v) for k, v in BIPED_MASSES.items()))
+
+    ma = (4 * second_difference(1) - second_difference(2)) / 3  # Σ mᵢ aᵢ, error O(dt⁴)
+    force = np.column_stack([lam["left_foot[0]"] + lam["right_foot[0]"],
+                             lam["left_foot[1]"] + lam["right_foot[1]"] - sum(BIPED_MASSES.values()) * 9.81])
+    assert np.max(np.abs(ma[:, [0, 2]])) > 100.0  # the posture law moves the body
+    assert np.max(np.abs(force[2:-2] - ma[:, [0, 2]])) <= 1e-5 * np.max(np.abs(ma))
+    rest = simulate(system, x0, t_end=4.0, sample_dt=0.01)
+    lam, pts = rest.constraint_forces(), rest.points()
+    assert np.max(np.abs(rest.x[-1, 7:])) < 1e-8
+    weight = sum(BIPED_MASSES.values()) * 9.81
+    vertical = lam["left_foot[1]"][-1] + lam["right_foot[1]"][-1]
+    assert vertical == pytest.approx(weight, rel=1e-9)
+    com = sum(mass * pts[k][-1, 0] for k, mass in BIPED_MASSES.items()) / sum(BIPED_MASSES.values())
+    cop = (-STANCE * lam["left_foot[1]"][-1] + STANCE * lam["right_foot[1]"][-1]) / vertical
+    assert abs(com) > 0.01  # the law's asymmetric posture: not a symmetric stance
+    assert cop == pytest.approx(com, abs=1e-9)

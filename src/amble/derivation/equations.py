@@ -21,7 +21,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..modelling.model import Model, t
-from .holonomic import Holonomic, holonomic_terms
+from .holonomic import Holonomic, holonomic_terms, refuse_constrained
 from .hzd import hzd_law
 from .tree import tree_dynamics
 
@@ -243,6 +243,7 @@ def derive(model: Model, control: bool = True) -> Equations:
         subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
         u = u.xreplace(subs)
     if model.virtual is not None and control:  # the HZD law, as named intermediate quantities after the tree's
+        refuse_constrained(model, "the HZD input–output linearising law")
         defs, Mc, hc = compact if compact is not None else ([], M, h)
         hdefs, u = hzd_law(model, Mc, hc, model.generalized_force, B)
         if model.saturated:
