@@ -290,3 +290,15 @@ def test_a_biped_in_double_support_obeys_newton_for_its_whole_body():
     cop = (-STANCE * lam["left_foot[1]"][-1] + STANCE * lam["right_foot[1]"][-1]) / vertical
     assert abs(com) > 0.01  # the law's asymmetric posture: not a symmetric stance
     assert cop == pytest.approx(com, abs=1e-9)
+
+
+def test_the_equations_command_shows_the_constraints(tmp_path, capsys):
+    from amble.cli.main import main
+
+    path = tmp_path / "held.py"
+    path.write_text('from amble import HybridSystem, Model\n'
+                    'm = Model("held")\nx, z = m.coordinates("x z", unit="m")\n'
+                    'm.point("p", (x, z), mass=1.0)\nm.gravity(9.81)\nm.holonomic("rod", ["x**2 + z**2 - 1"])\n'
+                    'system = HybridSystem("held", m)\n')
+    assert main(["equations", str(path)]) == 0
+    assert "constraint rod: x**2 + z**2 - 1 = 0" in capsys.readouterr().out
