@@ -409,6 +409,8 @@ def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     """Switching surfaces of a mode's right-hand side (forces, controllers, the mass matrix)."""
     eq, m = mi.equations, mi.model
     exprs = [*eq.closed_loop_force, *eq.h, *eq.M]
+    if eq.holonomic is not None:  # a constraint written with Abs or Piecewise switches the flow too
+        exprs += [*eq.holonomic.J, *eq.holonomic.gamma]
     return switching_surfaces(exprs, [*m.q, *m.qd, t])
 
 
