@@ -196,9 +196,11 @@ def derive(model: Model, control: bool = True) -> Equations:
 
     Point masses take the Jacobian route, which needs no derivative of the (large) kinetic
     energy: with ``vᵢ = Jᵢ q̇`` and the convective acceleration ``aᵢ = (∂vᵢ/∂q) q̇``,
-    ``M = Σ mᵢ JᵢᵀJᵢ`` and ``h = Σ mᵢ Jᵢᵀaᵢ + ∂V/∂q``. Every other energy term (rotational
-    inertia, added terms, or ``K``/``V``/``L`` given outright) goes through the general
-    Euler–Lagrange expansion above. Both routes give the same equations. The bodies of a
+    ``M = Σ mᵢ JᵢᵀJᵢ`` and ``h = Σ mᵢ Jᵢᵀaᵢ + ∂V/∂q``. So does a body's rotational inertia
+    (``body_inertia``), in Kane's form: with its body-axes angular velocity ``ω = J_ω q̇`` and
+    ``α = (∂ω/∂q) q̇``, ``M += J_ωᵀ I J_ω`` and ``h += J_ωᵀ (I α + ω × I ω)`` (Euler's equations in
+    body axes). Every other energy term (added terms, or ``K``/``V``/``L`` given outright) goes
+    through the general Euler–Lagrange expansion above. Both routes give the same equations. The bodies of a
     rigid-body tree (``model.rigid_tree()``) take a third route, by recursion over the tree
     (:mod:`amble.derivation.tree`: composite rigid bodies for ``M``, Newton–Euler for ``h``).
     """
@@ -218,7 +220,7 @@ def derive(model: Model, control: bool = True) -> Equations:
             if model.tree is not None:
                 Mt, ht = tree_dynamics(model.tree, model.gravity_vector)
             _add_point_masses(model, M, h)
-            extra = sum(model._k_terms, sp.Integer(0))
+            extra = sum(_add_spins(model, M, h), sp.Integer(0))
             if extra != 0:
                 _add_lagrangian_terms(extra, q, qd, M, h)
         V = _potential_outside_tree(model) if model._k_override is None else model.V
@@ -281,6 +283,41 @@ def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:
             hi = m * (J[:, i].T * a)[0, 0]
             if hi != 0:
                 h[i] += hi
+
+
+def _add_spins(model: Model, M: sp.Matrix, h: sp.Matrix) -> list[sp.Expr]:
+    """Add the rotational inertia of ``body_inertia`` bodies to M and h by Kane's form (see
+    :func:`derive`) and return the kinetic terms left for the Euler–Lagrange expansion: the
+    Lagrangian route differentiates ½ ωᵀ I ω three times over, and its expression swells with the
+    depth of a chain (a 7-link chain written so took most of a minute to derive)."""
+    q, qd = model.q, model.qd
+    rest = list(model._k_terms)
+    for w, Im, term in getattr(model, "_spins", ()):
+        Jw = w.jacobian(qd)
+        # ω = Rᵀ Ṙ of a rotation R(q) is linear in q̇ with no other term; an inertia that moves
+        # with q or t, or a rotation prescribed in t, takes the general route
+        if Im.free_symbols & {t, *q, *qd} or Jw.free_symbols & {t, *qd} or t in w.free_symbols or term not in rest:
+            continue
+        rest.remove(term)
+        alpha = sp.zeros(3, 1)
+        for qk, vk in zip(q, qd):
+            dw = w.applyfunc(lambda e, qk=qk: model.diff(e, qk))
+            if any(e != 0 for e in dw):
+                alpha += dw * vk
+        Iw = Im * w
+        torque = Im * alpha + w.cross(Iw)
+        JI = Jw.T * Im
+        for i in range(len(q)):
+            for j in range(i, len(q)):
+                mij = (JI[i, :] * Jw[:, j])[0, 0]
+                if mij != 0:
+                    M[i, j] += mij
+                    if j != i:
+                        M[j, i] += mij
+            hi = (Jw[:, i].T * torque)[0, 0]
+            if hi != 0:
+                h[i] += hi
+    return rest
 
 
 def _potential_outside_tree(model: Model) -> sp.Expr:

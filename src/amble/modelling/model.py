@@ -63,6 +63,9 @@ class Model(Actuators):
         self.links: list[tuple[str, str]] = []
         self._k_terms: list[sp.Expr] = []
         self._k_added: list[sp.Expr] = []  # the add_kinetic terms among them (not rotational inertia)
+        #: each body_inertia's body angular velocity ω (body axes, in q and q̇), inertia and its
+        #: term ½ ωᵀ I ω of _k_terms: the derivation takes these by their Jacobians (Kane's form)
+        self._spins: list[tuple[sp.Matrix, sp.Matrix, sp.Expr]] = []
         self._v_terms: list[sp.Expr] = []
         self._k_override: sp.Expr | None = None
         self._v_override: sp.Expr | None = None
@@ -220,6 +223,7 @@ class Model(Actuators):
         W = Rm.T * self.dt(Rm)
         w = sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
         self._k_terms.append(sp.Rational(1, 2) * (w.T * Im * w)[0, 0])
+        self._spins.append((w, Im, self._k_terms[-1]))
 
     # ------------------------------------------------------------------ energies
     @declaration
@@ -422,6 +426,7 @@ class Model(Actuators):
         out.links = list(self.links)
         out._k_terms = [put(e) for e in self._k_terms]
         out._k_added = [put(e) for e in self._k_added]
+        out._spins = [(w.applyfunc(put), Im, put(e)) for w, Im, e in self._spins]
         out._v_terms = [put(e) for e in self._v_terms]
         for attr in ("_k_override", "_v_override", "_l_override"):
             e = getattr(self, attr)

@@ -40,7 +40,7 @@ def _extend(m: Model) -> tuple[Model, sp.Symbol, list[sp.Symbol]]:
     out = copy.copy(m)
     out.q, out.qd, out.units = list(m.q), list(m.qd), dict(m.units)
     out.params, out.domains = dict(m.params), dict(m.domains)
-    out._k_terms, out._k_added = list(m._k_terms), list(m._k_added)
+    out._k_terms, out._k_added, out._spins = list(m._k_terms), list(m._k_added), list(m._spins)
     (clock,) = out.coordinates("clock", unit=m.time_unit)
     held = [out.coordinates(f"held_{a.symbol}", unit=a.unit)[0] for a in m.actuators]
     for c in (clock, *held):  # ½ ċ²: a unit "inertia" that the impact of a footfall leaves alone
