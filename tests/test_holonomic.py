@@ -302,3 +302,37 @@ def test_the_equations_command_shows_the_constraints(tmp_path, capsys):
                     'system = HybridSystem("held", m)\n')
     assert main(["equations", str(path)]) == 0
     assert "constraint rod: x**2 + z**2 - 1 = 0" in capsys.readouterr().out
+
+
+def test_a_block_lifts_off_when_its_floor_force_falls_through_zero():
+    """A block sliding at speed v on the floor (z = 0) and pulled up by k x: λ = m g − k x
+    (holonomic_forces) crosses zero at t* = m g / (k v), where a guard on it switches to flight;
+    then z = k v (t − t*)³ / (6 m)."""
+    from amble import Explicit, Guard, holonomic_forces
+
+    def block(held: bool) -> Model:
+        m = Model("held" if held else "free")
+        x, z = m.coordinates("x z", unit="m")
+        mass, g, k = m.parameters(mass=2.0, g=9.81, k=4.0)
+        m.point("p", (x, z), mass=mass)
+        m.gravity(g)
+        m.force([0, k * x])
+        if held:
+            m.holonomic("floor", [z])
+        return m
+
+    held, free = block(True), block(False)
+    lam = holonomic_forces(held)["floor"]
+    mass, g, k = held.params
+    assert sp.simplify(lam - (mass * g - k * held.q[0])) == 0
+    system = HybridSystem("lift", {"held": held, "free": free})
+    system.transition("liftoff", "held", Guard(lam, direction=-1), Explicit(q=held.q, qd=held.qd), "free")
+    v = 0.5
+    traj = simulate(system, [0.0, 0.0, v, 0.0], t_end=12.0, rtol=1e-12, atol=1e-12)
+    t_star = 2.0 * 9.81 / (4.0 * v)
+    (lift,) = [e for e in traj.events if e.name == "liftoff"]
+    assert lift.t == pytest.approx(t_star, abs=1e-10)
+    assert traj.final_state[1] == pytest.approx(4.0 * v * (12.0 - t_star) ** 3 / 12.0, rel=1e-9)
+    kernels = compiled(system)
+    np.testing.assert_allclose(kernels.constraint_forces("held", 0.0, [1.0, 0.0, v, 0.0], [2.0, 9.81, 4.0]),
+                               [2.0 * 9.81 - 4.0], rtol=1e-14)
