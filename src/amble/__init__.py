@@ -19,7 +19,7 @@ from .version import __version__  # noqa: F401  (amble.__version__)
 #: public name → module (relative to this package) that defines it
 _WHERE: dict[str, str] = {
     **dict.fromkeys(("Equations", "derive"), ".derivation.equations"),
-    **dict.fromkeys(("contact_force", "unilateral_contact"), ".derivation.contact"),
+    **dict.fromkeys(("contact_force", "holonomic_forces", "unilateral_contact"), ".derivation.contact"),
     **dict.fromkeys(("AmbleError", "CompileError", "ConvergenceError", "ExpressionError", "ModelError", "OutputError",
                      "ParameterError",
                      "SchedulerError", "SimulationError", "StateError"), ".errors"),
@@ -97,7 +97,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
-    from .derivation.contact import contact_force, unilateral_contact  # noqa: F401
+    from .derivation.contact import contact_force, holonomic_forces, unilateral_contact  # noqa: F401
     from .derivation.equations import Equations, derive  # noqa: F401
     from .errors import (  # noqa: F401
         AmbleError,

@@ -21,6 +21,7 @@ import numpy as np
 import sympy as sp
 
 from ..derivation.equations import derive
+from ..derivation.holonomic import refuse_constrained
 from ..errors import StateError
 from ..modelling.geometry import t as _t
 from ..modelling.hybrid import HybridSystem
@@ -31,6 +32,7 @@ _FN: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 def _functions(model: Any) -> Any:
     hit = _FN.get(model)
     if hit is None:
+        refuse_constrained(model, "linearize")
         eq = derive(model)
         q, qd = model.q, model.qd
         us = list(eq.inputs)

@@ -82,6 +82,7 @@ ROW_OPS: tuple[tuple[int, str, str], ...] = (
     (0, "RHS", "dx/dt (nx)"),
     (1, "DYNAMICS", "M (nq × nq, row-major), h (nq), Γ (nq)"),
     (2, "RHS_JAC", "dx/dt (nx), then [∂f/∂x, ∂f/∂p] (nx rows of SC columns)"),
+    (3, "CONSTRAINT_FORCES", "λ of the mode's holonomic constraints (m; none for an unconstrained mode)"),
 )
 
 #: The sensitivity buffer (float64, ``_c/sensitivity.h``) of a run that carries ∂x/∂(x0, p), in

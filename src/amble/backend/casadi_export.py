@@ -247,6 +247,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     actuators has ``nu = 0``.
     """
     from ..derivation.equations import derive
+    from ..derivation.holonomic import refuse_constrained
     from ..derivation.impact import impulse_data
     from ..modelling.contact import reaction
     from ..modelling.model import t as time
@@ -262,6 +263,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
         raise ModelError(f"system {system.name!r}: the footfall {tr.name!r} must be an Impact (derived) reset, "
                          f"not {type(tr.reset).__name__}")
     m = system.modes[modes[0]]
+    refuse_constrained(m, "gait optimisation")
     eq = derive(m, control=False)  # the inputs are unknowns of the problem: no feedback law
     n, d = len(m.q), m.dims
     inputs = list(getattr(m, "inputs", []) or [])

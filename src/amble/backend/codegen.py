@@ -20,6 +20,7 @@ import sympy as sp
 from sympy.core.relational import Relational
 
 from ..derivation.equations import derive
+from ..derivation.holonomic import Holonomic
 from ..derivation.impact import impulse_data
 from ..derivation.switching import switching_surfaces
 from ..modelling.hybrid import HybridSystem, target_exprs
@@ -39,12 +40,14 @@ from .variational_codegen import derivative_kernels, derivative_stubs
 
 
 def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, nm: dict[sp.Symbol, str],
-                   prelude: str, hoist: Hoister, prelude_ops: int = 0) -> str:
+                   prelude: str, hoist: Hoister, prelude_ops: int = 0, hol: Holonomic | None = None,
+                   shared: bool = False) -> str:
     """``mh_k`` (the lower triangle of M, h and Γ — emitted once: for a large tree it is most of
     the unit and of the compile time), and the two kernels that use it: ``rhs_k`` (q̈ = M⁻¹ (Γ − h)
     by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display). Parameter-only
     subexpressions are read from the prelude (``hoist``), and so are the pivots and multipliers of
-    a leading block of M that depends on parameters only (the compass gait's M₀₀)."""
+    a leading block of M that depends on parameters only (the compass gait's M₀₀). A mode with
+    holonomic constraints (``hol``) solves its KKT system instead (:func:`_holonomic_code`)."""
     tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)] + [f"h[{i}]" for i in range(n)]
     tg += [f"G[{i}]" for i in range(n)]
     ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
@@ -77,19 +80,49 @@ def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix,
     else:
         out, dyn = [UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
     rhs_mh = f"mh_{k}" if out[0] is inlined else dyn
-    out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
-            f"    double M[{n * n}], h[{n}], f[{n}];\n",
-            f"    {rhs_mh}(t, x, p, M, h, f);\n",
-            f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
-            ldl_solve_code(n, "M", "f", known=known, order=order, nonzero=nonzero),
-            f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
-            "    return 0;\n}\n"]
+    if hol is not None:
+        out.append(_holonomic_code(k, n, rhs_mh, hol, nm, hoist, shared))
+    else:
+        out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
+                f"    double M[{n * n}], h[{n}], f[{n}];\n",
+                f"    {rhs_mh}(t, x, p, M, h, f);\n",
+                f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
+                ldl_solve_code(n, "M", "f", known=known, order=order, nonzero=nonzero),
+                f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
+                "    return 0;\n}\n",
+                f"static int constraint_forces_{k}(double t, const double *x, const double *p, double *lam) {{\n",
+                "    (void)t; (void)x; (void)p; (void)lam;\n    return 0;\n}\n"]
     out += [f"static void dynamics_{k}{sig} {{\n",
             f"    {dyn}(t, x, p, M, h, G);\n",
             f"    for (int i = 0; i < {n}; ++i)\n",
             f"        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
             "}\n"]
     return "".join(out)
+
+
+def _holonomic_code(k: int, n: int, mh: str, hol: Holonomic, nm: dict[sp.Symbol, str], hoist: Hoister,
+                    shared: bool) -> str:
+    """``accel_k`` (q̈ and λ of ``M q̈ = Γ − h + Jᵀλ``, ``J q̈ = γ``, by ``amble_holonomic_solve``:
+    the Cholesky factor of M, then the m × m system of λ), and the two kernels that use it:
+    ``rhs_k`` and ``constraint_forces_k`` (λ, :mod:`amble.derivation.holonomic`)."""
+    m = hol.J.rows
+    tg = [f"J[{a * n + b}]" for a in range(m) for b in range(n)] + [f"gam[{a}]" for a in range(m)]
+    ex = [hol.J[a, b] for a in range(m) for b in range(n)] + list(hol.gamma)
+    body = _block(tg, hoist(ex), {**nm, **hoist.names}, shared=shared)
+    return "".join([
+        f"static int accel_{k}(double t, const double *x, const double *p, double *f, double *lam) {{\n",
+        f"    double M[{n * n}], h[{n}], J[{m * n}], gam[{m}];\n",
+        f"    {mh}(t, x, p, M, h, f);\n",
+        f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
+        body,
+        f"    return amble_holonomic_solve({n}, {m}, M, J, gam, f, lam);\n}}\n",
+        f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
+        f"    double f[{n}], lam[{m}];\n",
+        f"    const int err = accel_{k}(t, x, p, f, lam);\n    if (err) return err;\n",
+        f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
+        "    return 0;\n}\n",
+        f"static int constraint_forces_{k}(double t, const double *x, const double *p, double *lam) {{\n",
+        f"    double f[{n}];\n    return accel_{k}(t, x, p, f, lam);\n}}\n"])
 
 
 #: Largest ``mh_k`` (operations of M, h, Γ) that is forced inline into ``rhs_k`` and ``dynamics_k``.
@@ -163,7 +196,8 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
         prelude = _defs_code(defs, nm, hoist)
         # each named quantity is at least one operation: a lower bound of the prelude's size
-        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude, hoist, len(defs)))
+        w(_dynamics_code(k, n, eqM, eqh, eq.closed_loop_force, nm, prelude, hoist, len(defs), eq.holonomic,
+                         m.tree is not None))
         # guards of this mode's transitions
         trs = trs_by_mode[name]
         w(f"static void guards_{k}(double t, const double *x, const double *p, double *g) {{\n")
@@ -262,6 +296,8 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
              "switches_{}(t, x, p, s)", mode_list, "mode")
     dispatch("switches_dot(int mode, double t, const double *x, const double *dx, const double *p, double *s)",
              "void", "switches_dot_{}(t, x, dx, p, s)", mode_list, "mode")
+    dispatch("constraint_forces(int mode, double t, const double *x, const double *p, double *lam)", "int",
+             "constraint_forces_{}(t, x, p, lam)", mode_list, "mode")
     dispatch("dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G)",
              "void", "dynamics_{}(t, x, p, M, h, G)", mode_list, "mode")
     dispatch("energy(int mode, double t, const double *x, const double *p, double *out)", "void",
@@ -299,6 +335,7 @@ def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool
         "dims": system.dims,
         "switches": [{"mode": mn, "expr": str(e)} for mn in mode_list for e in switches[mn]],
         "derivatives": derivatives,
+        "constraints": {mn: list(system.modes[mn].constraint_names) for mn in mode_list},
     }
     return "".join(out), meta
 
@@ -372,6 +409,8 @@ def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     """Switching surfaces of a mode's right-hand side (forces, controllers, the mass matrix)."""
     eq, m = mi.equations, mi.model
     exprs = [*eq.closed_loop_force, *eq.h, *eq.M]
+    if eq.holonomic is not None:  # a constraint written with Abs or Piecewise switches the flow too
+        exprs += [*eq.holonomic.J, *eq.holonomic.gamma]
     return switching_surfaces(exprs, [*m.q, *m.qd, t])
 
 

@@ -379,6 +379,21 @@ class Kernels:
         out = self._many("DYNAMICS", mode, t, X, p, nq * nq + 2 * nq)
         return out[:, : nq * nq].reshape(-1, nq, nq), out[:, nq * nq : nq * nq + nq], out[:, nq * nq + nq :]
 
+    def constraint_names(self, mode: str | int) -> list[str]:
+        """The names of a mode's holonomic constraint equations, in the order of λ (empty: none)."""
+        return list(self.meta.get("constraints", {}).get(self.meta["modes"][self.mode_index(mode)], []))
+
+    def constraint_forces(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """The forces ``λ`` of a mode's holonomic constraints at a state (``M q̈ + h = Γ + Jᵀλ``,
+        ``J = ∂φ/∂q``; :meth:`amble.Model.holonomic`), one per equation (empty for a mode without)."""
+        return self.constraint_forces_many(mode, t, np.asarray(x, dtype=np.float64)[None, :], p)[0]
+
+    def constraint_forces_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray
+                               ) -> np.ndarray:
+        """:meth:`constraint_forces` at every row of ``X`` in one compiled call: ``n × m``. ``t``,
+        ``p`` as for :meth:`rhs_many`."""
+        return self._many("CONSTRAINT_FORCES", mode, t, X, p, len(self.constraint_names(mode)))
+
     def rhs_jacobian_many(self, mode: str | int, t: float | np.ndarray, X: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`rhs_jacobian` at every row of ``X`` in one compiled call: ``f`` (``n × nx``),

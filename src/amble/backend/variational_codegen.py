@@ -59,6 +59,7 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
     m, eq, k = mi.model, mi.equations, mi.index
     n = len(m.q)
     defs, M, h = _defs(mi)
+    hol = eq.holonomic
     if of_params:
         inputs = [s if s is not None else sp.Dummy() for s in _param_symbols(m, params)]
         col = "NXMAX + v"
@@ -69,10 +70,15 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
     low = [(i, j) for i in range(n) for j in range(i + 1)]
     exprs = [M[i, j] for i, j in low] + [eq.closed_loop_force[i] - h[i] for i in range(n)]
     vt = [f"M[{i * n + j}]" for i, j in low] + [f"f[{i}]" for i in range(n)]
-    rows = [i * n + j for i, j in low] + [None] * n
+    rows = [("dM", i * n + j) for i, j in low] + [("dF", i) for i in range(n)]
+    if hol is not None:  # J and γ of the constraints, and their tangents
+        mc = hol.J.rows
+        exprs += [hol.J[a, b] for a in range(mc) for b in range(n)] + list(hol.gamma)
+        vt += [f"Jh[{a * n + b}]" for a in range(mc) for b in range(n)] + [f"gam[{a}]" for a in range(mc)]
+        rows += [("dJ", a * n + b) for a in range(mc) for b in range(n)] + [("dG", a) for a in range(mc)]
 
     def target(o: int, v: int) -> str:
-        return f"dM[{rows[o] * nv + v}]" if rows[o] is not None else f"dF[{(o - len(low)) * nv + v}]"
+        return f"{rows[o][0]}[{rows[o][1] * nv + v}]"
 
     if of_params:
         code = f"static int rhs_jacp_{k}(double t, const double *x, const double *p, double *J) {{\n"
@@ -80,16 +86,11 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
         code = f"static int rhs_jac_{k}(double t, const double *x, const double *p, double *dx, double *J) {{\n"
     code += f"    double M[{n * n}], f[{n}], dM[{n * n * nv}], dF[{n * nv}];\n    (void)t; (void)p;\n"
     code += "    memset(dM, 0, sizeof dM);\n    memset(dF, 0, sizeof dF);\n"
+    if hol is not None:
+        code += (f"    double Jh[{mc * n}], gam[{mc}], lam[{mc}], dJ[{mc * n * nv}], dG[{mc * nv}];\n"
+                 "    memset(dJ, 0, sizeof dJ);\n    memset(dG, 0, sizeof dG);\n")
     code += jacobian_block(exprs, vt, target, inputs, names, defs=defs)
-    code += f"    if (amble_chol_factor({n}, M)) return AMBLE_ERR_SINGULAR_MASS;\n"
-    code += f"    amble_chol_apply({n}, M, f, 1);\n"
-    # ∂q̈ = M⁻¹ (∂F − ∂M q̈), ∂M symmetric (its lower triangle was differentiated)
-    code += f"    for (int i = 0; i < {n}; ++i)\n        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
-    code += f"            double r = dF[i * {nv} + v];\n"
-    code += (f"            for (int l = 0; l < {n}; ++l)\n"
-             f"                r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n")
-    code += f"            dF[i * {nv} + v] = r;\n        }}\n"
-    code += f"    amble_chol_apply_rows({n}, M, dF, {nv});\n"
+    code += _acceleration_tangent_code(n, len(inputs), nv, None if hol is None else mc)
     code += f"    for (int i = 0; i < {n}; ++i) {{\n"
     if of_params:
         code += (f"        for (int v = 0; v < {len(inputs)}; ++v) {{\n"
@@ -102,6 +103,34 @@ def _flow_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[
                  f"            J[({n} + i) * SC + v] = dF[i * {nv} + v];\n        }}\n")
     code += "    }\n    return 0;\n}\n"
     return code
+
+
+def _acceleration_tangent_code(n: int, ni: int, nv: int, mc: int | None) -> str:
+    """C statements leaving ``f = q̈`` and ``dF`` = its tangents (``ni`` directions, ``nv`` columns)
+    from ``M``, ``f = F``, ``dM``, ``dF``: ``M q̈' = F' − M' q̈``, solved with the factor of ``M``
+    (``M⁻¹`` is never formed). With ``mc`` holonomic constraints (``Jh``, ``gam``, ``dJ``, ``dG``)
+    the constrained system ``M q̈ = F + Jᵀλ``, ``J q̈ = γ`` and its tangent
+    ``M q̈' = F' − M' q̈ + J'ᵀλ + Jᵀλ'``, ``J q̈' = γ' − J' q̈`` (``amble_holonomic_tangent``)."""
+    if mc is None:
+        code = f"    if (amble_chol_factor({n}, M)) return AMBLE_ERR_SINGULAR_MASS;\n"
+        code += f"    amble_chol_apply({n}, M, f, 1);\n"
+    else:
+        code = f"    int err = amble_holonomic_solve({n}, {mc}, M, Jh, gam, f, lam);\n    if (err) return err;\n"
+    # ∂q̈ = M⁻¹ (∂F − ∂M q̈), ∂M symmetric (its lower triangle was differentiated)
+    code += f"    for (int i = 0; i < {n}; ++i)\n        for (int v = 0; v < {ni}; ++v) {{\n"
+    code += f"            double r = dF[i * {nv} + v];\n"
+    code += (f"            for (int l = 0; l < {n}; ++l)\n"
+             f"                r -= dM[(l <= i ? i * {n} + l : l * {n} + i) * {nv} + v] * f[l];\n")
+    if mc is not None:
+        code += f"            for (int c = 0; c < {mc}; ++c) r += dJ[(c * {n} + i) * {nv} + v] * lam[c];\n"
+    code += f"            dF[i * {nv} + v] = r;\n        }}\n"
+    if mc is None:
+        return code + f"    amble_chol_apply_rows({n}, M, dF, {nv});\n"
+    code += f"    for (int c = 0; c < {mc}; ++c)\n        for (int v = 0; v < {ni}; ++v) {{\n"
+    code += f"            double r = dG[c * {nv} + v];\n"
+    code += f"            for (int l = 0; l < {n}; ++l) r -= dJ[(c * {n} + l) * {nv} + v] * f[l];\n"
+    code += f"            dG[c * {nv} + v] = r;\n        }}\n"
+    return code + f"    err = amble_holonomic_tangent({n}, {mc}, {nv}, M, Jh, dF, dG);\n    if (err) return err;\n"
 
 
 def rhs_jacobian_code(mi: ModeInfo, names: dict[sp.Symbol, str], params: list[str]) -> str:

@@ -237,6 +237,8 @@ def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
             entry["input_limits"] = m.input_limits
             entry["control"] = ("hybrid zero dynamics" if m.virtual is not None else
                                 [_text(e) for e in m.control_law])
+        if eq.holonomic is not None:  # held by φ(q) = 0: M q̈ + h = Γ + Jᵀλ
+            entry["constraints"] = {n: _text(e) for n, e in zip(eq.holonomic.names, eq.holonomic.phi)}
         if args.latex:
             entry["latex_parts"] = _mode_latex(m, eq)
             parts = entry["latex_parts"]
@@ -282,6 +284,8 @@ def _print(out: dict[str, Any], latex: bool) -> None:
             if "inputs" in e:
                 print(f"  inputs u = ({', '.join(e['inputs'])}), B = {e['input_matrix']}")
                 print(f"  control: {e['control']}")
+        for name, phi in e.get("constraints", {}).items():
+            print(f"  constraint {name}: {phi} = 0  (M q̈ + h = Γ + Jᵀλ)")
         print(f"  operations (shared subexpressions): {e['operation_count']}")
     for tr in out["transitions"]:
         g = tr["guard_detail"]

@@ -31,11 +31,13 @@ from ..modelling.hybrid import Explicit, HybridSystem, Transition
 from ..modelling.model import Model
 from ..modelling.text import expr_of
 from .equations import derive
+from .holonomic import refuse_constrained
 
 
 def contact_force(model: Model, gap: Any) -> sp.Expr:
     """The multiplier ``λ(q, q̇, t)`` (N per unit of ``∂φ/∂q``; N for a gap in metres along a
     unit normal) that holds ``φ(q, t) = 0`` on ``model`` (see the module docstring)."""
+    refuse_constrained(model, "contact_force")
     eq = derive(model)
     J, w = _jacobian_and_w(model, gap)
     phid = _normal_velocity(model, gap)
@@ -44,6 +46,21 @@ def contact_force(model: Model, gap: Any) -> sp.Expr:
     free = eq.closed_loop_force - eq.h
     lam = -((w.T * free)[0, 0] + b) / (J * w)[0, 0]
     return sp.cancel(lam) if len(model.q) <= 3 else lam
+
+
+def holonomic_forces(model: Model) -> dict[str, sp.Expr]:
+    """``λ(q, q̇, t)`` of each equation of a mode's holonomic constraints (:meth:`Model.holonomic`),
+    by name (:attr:`Model.constraint_names`), as expressions: with ``W = M⁻¹Jᵀ``,
+    ``λ = (J W)⁻¹ (γ − Wᵀ (Γ − h))`` — the values ``Kernels.constraint_forces`` computes, written
+    out so that a guard can use them (a foot lifts off when its normal force falls through zero).
+    Two symbolic solves (with ``M``, then with ``J W``): for models of a few coordinates."""
+    eq = derive(model)
+    hol = eq.holonomic
+    if hol is None:
+        raise ModelError(f"model {model.name!r} declares no holonomic constraints")
+    W = eq.M.LUsolve(hol.J.T)
+    lam = (hol.J * W).LUsolve(hol.gamma - W.T * (eq.closed_loop_force - eq.h))
+    return dict(zip(hol.names, lam))
 
 
 def _jacobian_and_w(model: Model, gap: Any) -> tuple[sp.Matrix, sp.Matrix]:

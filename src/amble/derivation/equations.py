@@ -21,6 +21,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..modelling.model import Model, t
+from .holonomic import Holonomic, holonomic_terms, refuse_constrained
 from .hzd import hzd_law
 from .tree import tree_dynamics
 
@@ -46,6 +47,9 @@ class Equations:
     inputs: list[sp.Symbol] = field(default_factory=list)
     #: the closed-loop law of every input (nu × 1, zero where none; ``M`` and ``h`` substituted)
     u: sp.Matrix | None = None
+    #: the mode's holonomic constraints ``φ``, ``J = ∂φ/∂q``, ``γ = −J̇ q̇`` (None: unconstrained);
+    #: the motion is then ``M q̈ + h = Γ + Jᵀλ``, ``J q̈ = γ`` (:mod:`amble.derivation.holonomic`)
+    holonomic: Holonomic | None = None
 
     @cached_property
     def closed_loop_force(self) -> sp.Matrix:
@@ -241,6 +245,7 @@ def derive(model: Model, control: bool = True) -> Equations:
         subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
         u = u.xreplace(subs)
     if model.virtual is not None and control:  # the HZD law, as named intermediate quantities after the tree's
+        refuse_constrained(model, "the HZD input–output linearising law")
         defs, Mc, hc = compact if compact is not None else ([], M, h)
         hdefs, u = hzd_law(model, Mc, hc, model.generalized_force, B)
         if model.saturated:
@@ -248,7 +253,7 @@ def derive(model: Model, control: bool = True) -> Equations:
                            for e, a in zip(u, model.actuators)])
         compact = ([*defs, *hdefs], Mc, hc)
     return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy,
-                     compact=compact, B=B, inputs=model.inputs, u=u)
+                     compact=compact, B=B, inputs=model.inputs, u=u, holonomic=holonomic_terms(model))
 
 
 def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:

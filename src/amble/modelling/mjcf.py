@@ -32,9 +32,11 @@ are actuators, tendons without stiffness or damping, inactive equality constrain
 forces (``density``, ``viscosity``, ``wind``); contacts are not read (the model has no ground).
 A linear ``<equality><joint>`` between two hinges or slides, ``θ₁ = c0 + c1 θ₂``, is a mimic
 joint of the tree (:mod:`amble.modelling.tree`): the joint read later follows the other, with one
-coordinate fewer (MuJoCo holds the same relation by a stiff constraint force).
+coordinate fewer (MuJoCo holds the same relation by a stiff constraint force). An
+``<equality><connect>`` of two bodies (a closed loop) is a holonomic constraint of the model
+(:meth:`~amble.modelling.model.Model.holonomic`), exact where MuJoCo's is soft.
 Refused with a one-line :class:`~amble.errors.ModelError` naming the element: any other active
-equality constraint (a closed loop, a weld, a tendon or polynomial coupling), a tendon with
+equality constraint (a weld, a connect of sites, a tendon or polynomial coupling), a tendon with
 stiffness or damping, gravity compensation, damping, armature or stiffness on a free or ball
 joint, a free joint below another body, flexible bodies, and a file that MuJoCo's compiler
 refuses (its message is given).
@@ -50,8 +52,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import sympy as sp
 
 from ..errors import ModelError
+from .dag import free_symbols
 from .tree import Joint
 
 #: MuJoCo's joint types (``mjtJoint``)
@@ -94,27 +98,39 @@ def _quat_matrix(q: np.ndarray) -> np.ndarray:
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def _check_whole(m: Any, label: str) -> dict[int, tuple[int, float, float]]:
+def _check_whole(m: Any, label: str) -> tuple[dict[int, tuple[int, float, float]], list[tuple]]:
     """Refuse what the tree cannot hold; warn about what it leaves out. Returns the joints tied
-    to another by a linear ``<equality><joint>`` (``{follower: (joint followed, c1, c0)}``)."""
+    to another by a linear ``<equality><joint>`` (``{follower: (joint followed, c1, c0)}``) and
+    the ``<equality><connect>`` of two bodies (``(name, body 1, anchor 1, body 2, anchor 2)``)."""
     mujoco = _mujoco()
     eq_names = {0: "connect", 1: "weld", 2: "joint", 3: "tendon", 4: "flex", 5: "distance"}
-    inactive, ties = [], {}
+    inactive, ties, connects = [], {}, []
     for i in range(m.neq):
         kind = eq_names.get(int(m.eq_type[i]), "equality")
         nm = _name(m, mujoco.mjtObj.mjOBJ_EQUALITY, i, f"#{i}")
         if not bool(m.eq_active0[i]):
             inactive.append(nm)
             continue
+        if kind == "connect" and int(getattr(m, "eq_objtype", [mujoco.mjtObj.mjOBJ_BODY] * m.neq)[i]) == \
+                mujoco.mjtObj.mjOBJ_BODY:
+            data = np.asarray(m.eq_data[i][:6], dtype=float)
+            connects.append((nm, int(m.eq_obj1id[i]), data[:3], int(m.eq_obj2id[i]), data[3:6]))
+            continue
         tie = _joint_tie(m, i) if kind == "joint" else None
         if tie is None:
-            raise ModelError(f"MJCF {label}: equality constraint <{kind}> {nm!r} is active: closed loops and "
+            raise ModelError(f"MJCF {label}: equality constraint <{kind}> {nm!r} is active: welds and "
                              "couplings other than a linear one of two hinges or slides are not read")
         if tie[0] in ties:
             raise ModelError(f"MJCF {label}: equality constraint <joint> {nm!r}: joint 1 is tied twice")
         ties[tie[0]] = tie[1:]
     if inactive:
         warnings.warn(f"MJCF {label}: inactive equality constraints ignored: {', '.join(inactive)}", stacklevel=3)
+    _check_passive(m, label)
+    return ties, connects
+
+
+def _check_passive(m: Any, label: str) -> None:
+    mujoco = _mujoco()
     if getattr(m, "nflex", 0):
         raise ModelError(f"MJCF {label}: flexible bodies (<flex>) are not supported")
     for i in range(m.ntendon):
@@ -131,8 +147,7 @@ def _check_whole(m: Any, label: str) -> dict[int, tuple[int, float, float]]:
     if np.any(m.dof_frictionloss != 0):
         left_out.append("joint frictionloss")
     if left_out:
-        warnings.warn(f"MJCF {label}: ignored: {', '.join(left_out)}", stacklevel=3)
-    return ties
+        warnings.warn(f"MJCF {label}: ignored: {', '.join(left_out)}", stacklevel=4)
 
 
 def _joint_tie(m: Any, i: int) -> tuple[int, int, float, float] | None:
@@ -232,6 +247,23 @@ def _body_joints(ctx: dict, b: int, bname: str, parent: str | None) -> list[tupl
     return out
 
 
+def _connect(model: Any, label: str, name: str, body1: str, anchor1: np.ndarray, body2: str | None,
+             anchor2: np.ndarray) -> None:
+    """An ``<equality><connect>``: the anchor on ``body1`` (its frame) held at the anchor on
+    ``body2`` (its frame; the world's for ``None``) — MuJoCo computes the second from the first in
+    the file's pose, so the file's pose closes the loop. The components of ``p₁ − p₂`` that no
+    coordinate moves (the normal of a planar loop) are left out: they would make the constraint
+    Jacobian rank-deficient."""
+    tree = model.tree
+    p1 = tree.position(body1, tuple(anchor1))
+    p2 = tree.position(body2, tuple(anchor2)) if body2 is not None else sp.Matrix([float(v) for v in anchor2])
+    coords = set(model.q)
+    rows = [e for e in p1 - p2 if free_symbols(e) & coords]
+    if not rows:
+        raise ModelError(f"MJCF {label}: equality constraint <connect> {name!r} joins points that no joint moves")
+    model.holonomic(name, rows)
+
+
 def _joint_names(m: Any) -> dict[int, str]:
     """The joints' names (characters other than letters, digits and ``_`` as ``_``); unnamed joints
     are named when their body is read."""
@@ -250,7 +282,7 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
     m = compile_file(path)
     mujoco = _mujoco()
     label = path.name
-    ties = _check_whole(m, label)
+    ties, connects = _check_whole(m, label)
     model = cls(name or _name(m, mujoco.mjtObj.mjOBJ_MODEL, 0, "") or path.stem, dims=3)
     g = np.array(m.opt.gravity, dtype=float)
     gn = float(np.linalg.norm(g))
@@ -282,6 +314,8 @@ def build_model(cls: type, path: Any, name: str | None = None, fixed_base: bool 
             parent = frame
         names[b] = bname
     tree.joint_damping(ctx["damping"])
+    for nm, b1, a1, b2, a2 in connects:
+        _connect(model, label, nm, names[b1], a1, names[b2], a2)
     tree.file = path
     for pname, spec in (contact_points or {}).items():
         try:

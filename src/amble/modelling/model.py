@@ -75,6 +75,10 @@ class Model(Actuators):
         self._g: sp.Expr = sp.Integer(0)
         self._g_dir: sp.Matrix = self._down()
         self.tree: RigidTree | ConstrainedTree | None = None  # bodies and joints, if declared (:meth:`rigid_tree`)
+        #: holonomic constraints φ(q) = 0 of this mode by name (:meth:`holonomic`), and the
+        #: Baumgarte gains (α, β) of each set (1/time units; (0, 0): none)
+        self.holonomic_constraints: dict[str, list[sp.Expr]] = {}
+        self.baumgarte: dict[str, tuple[float, float]] = {}
 
     def dt(self, expr: Any) -> Any:
         """Total time derivative of an expression (or vector) of q and t, by the chain rule
@@ -335,6 +339,56 @@ class Model(Actuators):
             out += f
         return out
 
+    @declaration
+    def holonomic(self, name: str, constraints: Any, baumgarte: tuple[float, float] | None = None) -> None:
+        """Holonomic constraints ``φ(q) = 0`` (``m`` equations, expressions or text of the
+        coordinates and parameters) that hold throughout this mode: a closed kinematic loop (a
+        four-bar leg) or feet held on the ground (double support). The coordinates stay
+        independent symbols; the mode's dynamics become the index-1 system
+
+        ``M q̈ = Γ − h + Jᵀλ``,  ``J q̈ = γ``,  ``J = ∂φ/∂q``,  ``γ = −J̇ q̇``,
+
+        solved for ``q̈`` and the constraint forces ``λ`` (one per equation, in the units of
+        ``Γ`` per unit of ``φ``: a force for a length, a torque for an angle). ``Jᵀλ`` is the
+        generalized force the constraint exerts, so for ``φ`` = a foot's height ``λ`` is the
+        ground's normal force, positive while it pushes (``Kernels.constraint_forces``).
+
+        Start states must satisfy ``φ(q) = 0`` and ``J q̇ = 0``; the integration keeps them to
+        its tolerance. ``baumgarte=(α, β)`` (1/time unit, default none) adds the feedback
+        ``−2α J q̇ − β² φ`` to ``γ``, which pulls a drifting state back at the cost of the exact
+        flow (energy is then not conserved to the integrator's tolerance).
+        """
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"model {self.name!r}: a holonomic constraint needs a name, got {name!r}")
+        if name in self.holonomic_constraints:
+            raise ModelError(f"model {self.name!r}: holonomic constraint {name!r} is already declared")
+        rows = list(constraints) if isinstance(constraints, (list, tuple, sp.MatrixBase)) else [constraints]
+        if not rows:
+            raise ModelError(f"model {self.name!r}: holonomic constraint {name!r} has no equations")
+        exprs = [_expr(self, e, f"holonomic constraint {name!r}") for e in rows]
+        for e in exprs:
+            self._check_symbols(e, f"holonomic constraint {name!r}")
+            # rheonomic constraints (φ of t) would need ∂²φ/∂t² in γ: not supported
+            syms = free_symbols(e)  # a tree's positions are shared graphs: each part visited once
+            if t in syms or not (syms & set(self.q)):
+                raise ModelError(f"model {self.name!r}: holonomic constraint {name!r}: {e} must depend on the "
+                                 "coordinates and not on time")
+        gains = (0.0, 0.0) if baumgarte is None else tuple(float(g) for g in baumgarte)
+        if len(gains) != 2 or not all(math.isfinite(g) and g >= 0 for g in gains):
+            raise ModelError(f"model {self.name!r}: baumgarte gains of {name!r} must be two finite numbers ≥ 0, "
+                             f"got {baumgarte!r}")
+        self.holonomic_constraints[name] = exprs
+        self.baumgarte[name] = gains  # type: ignore[assignment]
+
+    @property
+    def constraint_names(self) -> list[str]:
+        """One name per constraint equation, in the order of ``λ``: ``<name>`` for a single
+        equation, ``<name>[i]`` for the i-th of several."""
+        out = []
+        for name, exprs in self.holonomic_constraints.items():
+            out += [name] if len(exprs) == 1 else [f"{name}[{i}]" for i in range(len(exprs))]
+        return out
+
     # ------------------------------------------------------------------ derived models
     def constrained(self, name: str, substitutions: dict[Any, Any]) -> Model:
         """A copy of this model with some coordinates tied to the others (e.g. a locked knee:
@@ -385,6 +439,8 @@ class Model(Actuators):
             raise ModelError(f"model {self.name!r}: a control law written with mass_and_bias() cannot be carried "
                              "into a constrained model; declare it on that model")
         self._copy_actuators(out, subs, vsubs)
+        out.holonomic_constraints = {k: [put(e) for e in v] for k, v in self.holonomic_constraints.items()}
+        out.baumgarte = dict(self.baumgarte)
         return out
 
     # ------------------------------------------------------------------ helpers

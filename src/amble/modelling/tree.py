@@ -304,6 +304,14 @@ class RigidTree:
             if bad:
                 raise ModelError(f"model {m.name!r}: {what} of body {b.name!r} has a non-finite entry {bad[0]}")
 
+    def position(self, body: str, at: Sequence[Any] = (0, 0, 0)) -> sp.Matrix:
+        """World position of the point ``at`` (body frame) of ``body``, without naming it (a loop
+        closure's anchor: ``Model.holonomic``)."""
+        if body not in self._by_name:
+            raise ModelError(f"model {self.model.name!r}: no body named {body!r}")
+        b = self._by_name[body]
+        return self.defs.expand(b.p + self.defs.vec(_matmul(b.R, _vec(at))))
+
     def point(self, name: str, body: str, at: Sequence[Any] = (0, 0, 0)) -> sp.Matrix:
         """Name a point fixed on ``body`` at ``at`` (body frame); returns its world position."""
         if body not in self._by_name:

@@ -153,6 +153,21 @@ class Trajectory:
         """Kinetic and potential energy per row, shape (N, 2), in J."""
         return self.kernels.energy_rows(self.t, self.mode, self.x, self.params)
 
+    def constraint_forces(self) -> dict[str, np.ndarray]:
+        """Constraint equation name → its force ``λ`` per row (``M q̈ + h = Γ + Jᵀλ``, ``J = ∂φ/∂q``:
+        N for a length, N·m for an angle; :meth:`amble.Model.holonomic`), NaN in rows of a mode
+        that does not hold it; empty if no mode has holonomic constraints."""
+        k, out = self.kernels, {}
+        for mi in range(k.n_modes):
+            names, rows = k.constraint_names(mi), np.nonzero(self.mode == mi)[0]
+            if not names or not rows.size:
+                continue
+            nx = k.meta["nx"][mi]
+            lam = k.constraint_forces_many(mi, self.t[rows], self.x[rows, :nx], self.params)
+            for j, name in enumerate(names):
+                out.setdefault(name, np.full(len(self.t), np.nan))[rows] = lam[:, j]
+        return out
+
     def inputs(self) -> dict[str, np.ndarray]:
         """Input name → value per sample (N·m or N) from the closed-loop law; empty without
         actuators (see :mod:`amble.simulation.inputs`)."""

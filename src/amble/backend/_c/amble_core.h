@@ -289,4 +289,69 @@ static int amble_kkt_solve_columns(int ne, int nc, const double *Me, const doubl
     return 0;
 }
 
+/* Constrained accelerations of a mode with m holonomic constraints (the model's unit calls it from
+ * its right-hand side): M q̈ = f + Jᵀλ, J q̈ = γ, with the Cholesky factor of M (overwritten) and
+ * X = M⁻¹[f Jᵀ]: λ = (J X_J)⁻¹ (γ − J X_f), q̈ = X_f + X_J λ. f (n) is overwritten by q̈, lam (m)
+ * receives λ. A singular M, or J without full row rank (J M⁻¹ Jᵀ singular), is
+ * AMBLE_ERR_SINGULAR_MASS. */
+static int amble_holonomic_solve(int n, int m, double *M, const double *J, const double *gam, double *f,
+                                 double *lam) {
+    const int w = m + 1;
+    double X[n * w], S[m * m];
+    if (amble_chol_factor(n, M)) return AMBLE_ERR_SINGULAR_MASS;
+    for (int i = 0; i < n; ++i) {
+        X[i * w] = f[i];
+        for (int c = 0; c < m; ++c) X[i * w + 1 + c] = J[c * n + i];
+    }
+    amble_chol_apply_rows(n, M, X, w);
+    for (int a = 0; a < m; ++a) {
+        double r = gam[a];
+        for (int i = 0; i < n; ++i) r -= J[a * n + i] * X[i * w];
+        lam[a] = r;
+        for (int b = 0; b < m; ++b) {
+            double s = 0.0;
+            for (int i = 0; i < n; ++i) s += J[a * n + i] * X[i * w + 1 + b];
+            S[a * m + b] = s;
+        }
+    }
+    if (amble_chol_factor(m, S)) return AMBLE_ERR_SINGULAR_MASS;
+    amble_chol_apply(m, S, lam, 1);
+    for (int i = 0; i < n; ++i) {
+        double v = X[i * w];
+        for (int c = 0; c < m; ++c) v += X[i * w + 1 + c] * lam[c];
+        f[i] = v;
+    }
+    return 0;
+}
+
+/* The tangent of amble_holonomic_solve in nv directions: with L the Cholesky factor of M that it
+ * left, solve M a = R1 + Jᵀ l, J a = R2 (R1 n × nv, R2 m × nv, row-major); R1 is overwritten by a
+ * (the tangents of q̈), R2 by l (those of λ). */
+static int amble_holonomic_tangent(int n, int m, int nv, const double *L, const double *J, double *R1, double *R2) {
+    double XJ[n * m], S[m * m];
+    for (int i = 0; i < n; ++i)
+        for (int c = 0; c < m; ++c) XJ[i * m + c] = J[c * n + i];
+    amble_chol_apply_rows(n, L, XJ, m);
+    for (int a = 0; a < m; ++a)
+        for (int b = 0; b < m; ++b) {
+            double s = 0.0;
+            for (int i = 0; i < n; ++i) s += J[a * n + i] * XJ[i * m + b];
+            S[a * m + b] = s;
+        }
+    if (amble_chol_factor(m, S)) return AMBLE_ERR_SINGULAR_MASS;
+    amble_chol_apply_rows(n, L, R1, nv);
+    for (int c = 0; c < m; ++c)
+        for (int i = 0; i < n; ++i) {
+            const double j = J[c * n + i];
+            for (int v = 0; v < nv; ++v) R2[c * nv + v] -= j * R1[i * nv + v];
+        }
+    amble_chol_apply_rows(m, S, R2, nv);
+    for (int i = 0; i < n; ++i)
+        for (int c = 0; c < m; ++c) {
+            const double x = XJ[i * m + c];
+            for (int v = 0; v < nv; ++v) R1[i * nv + v] += x * R2[c * nv + v];
+        }
+    return 0;
+}
+
 #endif

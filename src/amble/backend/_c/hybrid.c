@@ -156,7 +156,7 @@ void amble_rows_kinematics(int64_t nrows, const double *t, const int *mode, cons
  * it are not evaluated), -1 if none, -2 for an unknown op. */
 int64_t amble_rows(int64_t n, int op, int mode, const double *t, int64_t ts, const double *x, int64_t xs,
                    const double *p, int64_t ps, double *out, int64_t os) {
-    if (op < ROP_RHS || op > ROP_RHS_JAC) return -2;
+    if (op < ROP_RHS || op > ROP_CONSTRAINT_FORCES) return -2;
     const int nx = MODE_NX[mode], nq = nx / 2;
     double pf[NPFULL];
     for (int64_t r = 0; r < n; ++r) {
@@ -166,7 +166,8 @@ int64_t amble_rows(int64_t n, int op, int mode, const double *t, int64_t ts, con
         int err = 0;
         if (op == ROP_RHS) err = rhs(mode, tr, xr, pf, o);
         else if (op == ROP_DYNAMICS) dynamics(mode, tr, xr, pf, o, o + nq * nq, o + nq * nq + nq);
-        else err = rhs_jac(mode, tr, xr, pf, o, o + nx) || rhs_jacp(mode, tr, xr, pf, o + nx);
+        else if (op == ROP_RHS_JAC) err = rhs_jac(mode, tr, xr, pf, o, o + nx) || rhs_jacp(mode, tr, xr, pf, o + nx);
+        else err = constraint_forces(mode, tr, xr, pf, o);
         if (err) return r;
     }
     return -1;

@@ -41,6 +41,7 @@ AMBLE_HIDDEN void amble_k_switches(int mode, double t, const double *x, const do
 AMBLE_HIDDEN void amble_k_switches_dot(int mode, double t, const double *x, const double *dx, const double *p, double *s);
 AMBLE_HIDDEN int amble_k_enabled(int tr, double t, const double *x, const double *p);
 AMBLE_HIDDEN int amble_k_reset(int tr, double t, const double *x, const double *p, double *xout, int *target);
+AMBLE_HIDDEN int amble_k_constraint_forces(int mode, double t, const double *x, const double *p, double *lam);
 AMBLE_HIDDEN void amble_k_dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G);
 AMBLE_HIDDEN void amble_k_energy(int mode, double t, const double *x, const double *p, double *out);
 AMBLE_HIDDEN void amble_k_kinematics(int mode, double t, const double *x, const double *p, double *pos, double *vel);
@@ -56,6 +57,7 @@ AMBLE_HIDDEN int amble_k_reset_jac(int tr, double t, const double *x, const doub
 #define enabled amble_k_enabled
 #define reset amble_k_reset
 #define dynamics amble_k_dynamics
+#define constraint_forces amble_k_constraint_forces
 #define energy amble_k_energy
 #define kinematics amble_k_kinematics
 #define rhs_jac amble_k_rhs_jac

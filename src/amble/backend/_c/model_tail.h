@@ -51,6 +51,9 @@ AMBLE_HIDDEN int amble_k_enabled(int tr, double t, const double *x, const double
 AMBLE_HIDDEN int amble_k_reset(int tr, double t, const double *x, const double *p, double *xout, int *target) {
     return reset(tr, t, x, p, xout, target);
 }
+AMBLE_HIDDEN int amble_k_constraint_forces(int mode, double t, const double *x, const double *p, double *lam) {
+    return constraint_forces(mode, t, x, p, lam);
+}
 AMBLE_HIDDEN void amble_k_dynamics(int mode, double t, const double *x, const double *p, double *M, double *h, double *G) {
     dynamics(mode, t, x, p, M, h, G);
 }
