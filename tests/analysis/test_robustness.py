@@ -69,6 +69,15 @@ def test_the_command_line_reports_the_norm_and_refuses_an_unknown_parameter(caps
     assert d["gsn_state"] >= d["gsn_coordinates"]["theta_dot"] > 0 and d["gsn_step_time"] > 0
     assert main(["robustness", "rimless-wheel", "--param", "mu"]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    # the gait from a guess of its own and a tolerance: the same norm
+    x = d["fixed_point"]
+    guess = "x0=" + ",".join(f"{v + 1e-3:.12g}" for v in x)
+    assert main(["robustness", "rimless-wheel", "--param", "slope", "--no-basin", "--json", "--guess", guess,
+                 "--tol", "1e-11"]) == 0
+    assert json.loads(capsys.readouterr().out)["gsn_state"] == pytest.approx(d["gsn_state"], rel=1e-8)
+    for bad in (["--guess", "x0=1,a"], ["--guess", "nowhere"], ["--tol", "-1"]):
+        assert main(["robustness", "rimless-wheel", "--param", "slope", "--no-basin", *bad]) == 2
+        assert len(capsys.readouterr().err.strip().splitlines()) == 1
 
 
 def _compass_with_a_step():

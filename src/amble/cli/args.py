@@ -206,3 +206,22 @@ def _check_model_path(spec: str) -> None:
     except (OSError, ValueError) as e:  # ENAMETOOLONG, ELOOP, EACCES …; ValueError: a NUL byte
         why = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
         raise ModelError(f"model file {_shown(path)}: cannot be opened ({why})") from None
+
+
+def parse_start(system: Any, text: str | None, params: dict[str, float], option: str) -> Any:
+    """A state given on the command line: ``'x0=V1,V2,...'`` (read with ``float``, never
+    evaluated) or ``'fixed-point'`` (the gait at ``params``); ``None`` for no text."""
+    if text is None:
+        return None
+    if text == "fixed-point":
+        from ..analysis.poincare import find_fixed_point
+
+        return find_fixed_point(system, params=params).fixed_point
+    if text.startswith("x0="):
+        vals = text[3:].split(",")
+        if vals and not vals[-1].strip():
+            vals = vals[:-1]  # a trailing comma is harmless
+        if any(not v.strip() for v in vals):  # an empty field between commas is a missing value
+            raise UsageError(f"x0: empty value at position {[v.strip() for v in vals].index('') + 1} in {text!r}")
+        return [_float(v, "x0") for v in vals]
+    raise UsageError(f"{option} expects 'fixed-point' or 'x0=V1,V2,...', got {text!r}")

@@ -20,7 +20,16 @@ from typing import Any
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, RESIDUAL_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
-from .args import UsageError, _float, _Parser, check_tol, load_model, parse_sets, robot_options, writable_path
+from .args import (
+    UsageError,
+    _Parser,
+    check_tol,
+    load_model,
+    parse_sets,
+    parse_start,
+    robot_options,
+    writable_path,
+)
 from .cache import add_parser as add_cache_parser
 from .doublings import EXAMPLE as DOUBLINGS_EXAMPLE
 from .doublings import add_parser as add_doublings_parser
@@ -70,23 +79,6 @@ def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
     return {"models": rows}
 
 
-def _start(s, text: str | None, params: dict[str, float]):
-    if text is None:
-        return None
-    if text == "fixed-point":
-        from ..analysis.poincare import find_fixed_point
-
-        return find_fixed_point(s, params=params).fixed_point
-    if text.startswith("x0="):
-        vals = text[3:].split(",")
-        if vals and not vals[-1].strip():
-            vals = vals[:-1]  # a trailing comma is harmless
-        if any(not v.strip() for v in vals):  # an empty field between commas is a missing value
-            raise UsageError(f"x0: empty value at position {[v.strip() for v in vals].index('') + 1} in {text!r}")
-        return [_float(v, "x0") for v in vals]
-    raise UsageError(f"--start expects 'fixed-point' or 'x0=V1,V2,...', got {text!r}")
-
-
 def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     from ..simulation.simulate import simulate
 
@@ -109,7 +101,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     if out_p and (any(m.inputs for m in s.modes.values()) or getattr(s, "hip", None) is not None):
         s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
     params = parse_sets(args.set)
-    x0 = _start(s, args.start, params)
+    x0 = parse_start(s, args.start, params, "--start")
     t_end, steps = args.time, args.steps
     if steps is None and t_end is None:  # 20 footfalls; a system that makes none runs for a second
         walks = any(tr.step for tr in s.transitions)
@@ -195,7 +187,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
     s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True, **robot_options(args))
     params = parse_sets(args.set)
-    guess = _start(s, args.guess, params) if args.guess else None
+    guess = parse_start(s, args.guess, params, "--guess") if args.guess else None
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol,
                           tol=check_tol(args.tol))
     out = lc.to_json()

@@ -7,8 +7,8 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
-from ..analysis.defaults import BASIN_STEPS
-from .args import UsageError, _float, load_model, parse_sets
+from ..analysis.defaults import BASIN_STEPS, RESIDUAL_TOL
+from .args import UsageError, _float, check_tol, load_model, parse_sets, parse_start
 
 EXAMPLE = "amble robustness compass-gait --param slope --json"
 
@@ -19,6 +19,10 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
     model_arg(r)
     r.add_argument("--param", required=True, metavar="NAME",
                    help="the parameter disturbed for one step, e.g. slope (the ramp of one step)")
+    r.add_argument("--guess", metavar="x0=V1,V2,...",
+                   help="'x0=V1,V2,...' initial guess of the gait's post-impact state (default: the model's)")
+    r.add_argument("--tol", type=float, default=RESIDUAL_TOL,
+                   help=f"the gait's fixed-point tolerance |P(x) - x| (default {RESIDUAL_TOL:g})")
     b = r.add_argument_group("basin of attraction (JSON key 'basin')")
     b.add_argument("--direction", action="append", metavar="NAME=V[,NAME=V...]",
                    help="a direction on the section to measure the distance to the basin's boundary along "
@@ -58,7 +62,9 @@ def cmd_robustness(args: argparse.Namespace) -> dict[str, Any]:
 
     dirs = None if args.direction is None else [parse_direction(t) for t in args.direction]
     system = load_model(args.model, derivatives=True)
-    lc = find_fixed_point(system, params=parse_sets(args.set))
+    params = parse_sets(args.set)
+    guess = parse_start(system, args.guess, params, "--guess")
+    lc = find_fixed_point(system, guess, params=params, tol=check_tol(args.tol))
     g = gait_sensitivity(lc, args.param)
     out = g.to_json()
     b = None if args.no_basin else basin_measures(
