@@ -313,30 +313,44 @@ def _compile(src: str, key: str, d: Path) -> tuple[Path, str]:
     capacity and toolchain); any other source is compiled on its own. A source with a function of
     its own unit (:func:`split_units`) is compiled as two units at once and linked: the largest
     kernel of a big tree model takes as long as everything else together, so on two cores the
-    wall time nearly halves."""
+    wall time nearly halves. A runtime object not yet cached (a machine's first build) is compiled
+    beside the model's units, not before them, and linked when both are done."""
+    from concurrent.futures import ThreadPoolExecutor
+
     from . import runtime
 
     cc = compiler()
     cap = runtime.capacity_of(src)
-    linked = [] if cap is None else [str(runtime.runtime_object(d, cap, runtime_toolchain()))]
-    with build_directory(d) as tmpd:
-        out = tmpd / "model.so"
-        base = [*cc.split(), *cflags(), "-std=c99", "-Werror=implicit-function-declaration", "-fPIC"]
-        main, own = split_units(src)
-        units = [main] if own is None else [main, own]
-        files = []
-        for i, text in enumerate(units):
-            files.append(tmpd / f"model{i or ''}.c")
-            files[-1].write_text(text)
-        if own is None:
-            run_compilers([[*base, "-shared", "-I", str(C_DIR), str(files[0]), *linked, "-o", str(out), "-lm"]], cc)
-        else:
-            objs = [f.with_suffix(".o") for f in files]
-            run_compilers([[*base, "-c", "-I", str(C_DIR), str(f), "-o", str(o)] for f, o in zip(files, objs)], cc)
-            run_compilers([[*base, "-shared", *map(str, objs), *linked, "-o", str(out), "-lm"]], cc)
-        if not out.is_file() or out.stat().st_size == 0:
-            raise CompileError(f"C compiler {cc!r} reported success but wrote no library")
-        digest = sha256_of(out)
-        so = d / f"{key}-{digest[:16]}.so"
-        os.replace(out, so)
+    tc = None if cap is None else runtime_toolchain()
+    ready = None if cap is None else runtime.cached_object(d, cap, tc)
+    pool = ThreadPoolExecutor(1) if cap is not None and ready is None else None
+    pending = None if pool is None else pool.submit(runtime.runtime_object, d, cap, tc)
+    try:
+        with build_directory(d) as tmpd:
+            out = tmpd / "model.so"
+            base = [*cc.split(), *cflags(), "-std=c99", "-Werror=implicit-function-declaration", "-fPIC"]
+            main, own = split_units(src)
+            units = [main] if own is None else [main, own]
+            files = []
+            for i, text in enumerate(units):
+                files.append(tmpd / f"model{i or ''}.c")
+                files[-1].write_text(text)
+            if own is None and pending is None:
+                linked = [] if ready is None else [str(ready)]
+                run_compilers([[*base, "-shared", "-I", str(C_DIR), str(files[0]), *linked, "-o", str(out), "-lm"]],
+                              cc)
+            else:
+                objs = [f.with_suffix(".o") for f in files]
+                run_compilers([[*base, "-c", "-I", str(C_DIR), str(f), "-o", str(o)] for f, o in zip(files, objs)],
+                              cc)
+                linked = [str(pending.result())] if pending is not None else [] if ready is None else [str(ready)]
+                run_compilers([[*base, "-shared", *map(str, objs), *linked, "-o", str(out), "-lm"]], cc)
+            if not out.is_file() or out.stat().st_size == 0:
+                raise CompileError(f"C compiler {cc!r} reported success but wrote no library")
+            digest = sha256_of(out)
+            so = d / f"{key}-{digest[:16]}.so"
+            os.replace(out, so)
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True)  # a failed model compile still leaves the runtime finished and cached
     return so, digest
