@@ -103,7 +103,7 @@ def run(quick: bool = False) -> tuple[str, list[Goal], dict[str, Any]]:
     load1 = os.getloadavg()
     rows, data, goals = [], {}, []
     for c, (_, label) in COMMANDS.items():
-        for s, sargs in SCHEDULERS.items():
+        for s in SCHEDULERS:
             m = {w: {k: _med(runs[(c, s, w)], k) for k in ("wall", "cpu", "sweep")} for w in (1, 2)}
             data[f"{c} {s}"] = m
             rows.append([label, s, f"{m[1]['wall']:.2f}", f"{m[2]['wall']:.2f}", f"{m[1]['cpu']:.2f}",
