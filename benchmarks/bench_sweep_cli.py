@@ -95,6 +95,80 @@ def _med(rs: list[dict[str, Any]], key: str) -> float:
     return statistics.median(r["summary"]["seconds"] if key == "sweep" else r[key] for r in rs)
 
 
+def _task_times(kind: str, chunk: int | None = None, points: int = 200) -> list[float]:
+    """CPU seconds of each task of the benchmark's branch (``kind="branch"``, slope 0.01…0.08 in
+    ``points`` values, ``chunk`` values a task, default the sweep's) or basin, in submission
+    order: the sweep run in this process with its task function timed (the thread's CPU time,
+    which the machine's load does not inflate)."""
+    import numpy as np
+
+    import amble.analysis.basin as basin_mod
+    import amble.analysis.fixed_points as fp_mod
+    from amble.analysis.sweep import sweep
+    from amble.cli.args import load_model
+
+    system = load_model("compass-gait", compiled=True, derivatives=True)
+    mod, name = (fp_mod, "_fp_task") if kind == "branch" else (basin_mod, "_basin_task")
+    raw, times = getattr(mod, name), []
+
+    def timed(*a: Any) -> Any:
+        t0 = time.thread_time()
+        out = raw(*a)
+        times.append(time.thread_time() - t0)
+        return out
+
+    setattr(mod, name, timed)
+    try:
+        if kind == "branch":
+            sweep(system, "fixed-point", {"slope": np.linspace(0.01, 0.08, points)}, scheduler="synchronous",
+                  progress=False, **({} if chunk is None else {"chunk": chunk}))
+        else:
+            sweep(system, "basin", {"stance": np.linspace(-0.35, -0.10, 100), "stance_dot": np.linspace(0.8, 1.4, 100)},
+                  params={"slope": 0.05}, scheduler="synchronous", progress=False)  # the CLI's defaults
+    finally:
+        setattr(mod, name, raw)
+    return times
+
+
+def _in_order(times: list[float], workers: int = 2) -> float:
+    """The time to finish tasks of these durations taken in order by the first free of ``workers``
+    (how a process pool or Dask hands them out)."""
+    import heapq
+
+    free = [0.0] * workers
+    for t in times:
+        heapq.heappush(free, heapq.heappop(free) + t)
+    return max(free)
+
+
+def balance(reps: int) -> tuple[str, dict[str, Any]]:
+    """How evenly the tasks of the benchmark's branch (former chunks of 32, and the default) and
+    basin fill two workers: a table and its numbers (medians of ``reps``)."""
+    from amble.analysis.fixed_points import default_chunk
+
+    cases = {f"branch of {n}, chunks of {c or default_chunk(n)} ({'default' if c is None else 'before'})":
+             ("branch", c, n) for n in (200, 100) for c in (32, None)}
+    cases["basin 100 × 100, 5 rows a task (default)"] = ("basin", None, 0)
+    got: dict[str, list[tuple[float, float, float, int]]] = {k: [] for k in cases}
+    for _ in range(reps):
+        for label, (kind, chunk, n) in cases.items():
+            ts = _task_times(kind, chunk, n)
+            got[label].append((sum(ts), max(ts), _in_order(ts), len(ts)))
+    rows, data = [], {}
+    for label, rs in got.items():
+        total, big, span = (statistics.median(r[i] for r in rs) for i in range(3))
+        bound = statistics.median(r[0] / r[2] for r in rs)
+        data[label] = {"tasks": rs[0][3], "cpu_s": total, "largest_s": big, "two_workers_s": span, "bound": bound}
+        rows.append([label, str(rs[0][3]), f"{total:.2f}", f"{big:.3f}", f"{span:.2f}", f"{bound:.2f}×"])
+    md = (f"**Tasks and workers.** CPU seconds of every task (the sweep in this process, each task timed; "
+          f"medians of {reps}) and the time two workers need taking them in order, the first free worker the "
+          "next task, as the process pool and Dask do: the most two free workers can gain over one from how "
+          "the sweep is cut, whatever the machine's load.\n\n"
+          + table(["sweep", "tasks", "task CPU s, sum", "largest task s", "2 workers, in order, s",
+                   "bound from the tasks"], rows))
+    return md, data
+
+
 def run(quick: bool = False) -> tuple[str, list[Goal], dict[str, Any]]:
     """The command-line table (Markdown), its goals and numbers."""
     reps = 3 if quick else 7
@@ -149,7 +223,8 @@ def run(quick: bool = False) -> tuple[str, list[Goal], dict[str, Any]]:
                    "sweep s, 1 w.", "sweep s, 2 w.", "wall 2 ÷ 1", "best 2 ÷ 1", "sweep 2 ÷ 1",
                    "cores used, 2 w.", "bound on 2 free cores"], rows))
     data["load_before"], data["load_after"] = load0, load1
-    return md, goals, data
+    bal_md, data["balance"] = balance(3)
+    return md + "\n\n" + bal_md, goals, data
 
 
 if __name__ == "__main__":
