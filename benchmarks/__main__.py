@@ -3,7 +3,9 @@
 Usage: ``python -m benchmarks [--quick] [--only derive,walk,startup,sweep,gaitopt,jacobian,tree,calls,movie,mfpt]
 [--output PATH | --no-write]``.
 ``--quick`` shrinks every benchmark (fewer chain sizes, 20 walking steps) for a smoke run; the
-published numbers come from a full run.
+published numbers come from a full run. With ``--only`` and an existing output file, only the
+chosen sections and their rows of the goals table are replaced in it (:func:`splice`); the other
+sections, and any text written by hand, are kept.
 """
 
 from __future__ import annotations
@@ -61,10 +63,13 @@ def _runner(name: str) -> Callable[[bool], Section]:
     return importlib.import_module(f"benchmarks.bench_{name}").run
 
 
+GOAL_HEADER = ("goal", "target", "measured (median)", "")
+
+
 def _goals_table(sections: list[Section]) -> str:
     mark = {True: "met", False: "**missed**", None: "not measured"}
     rows = [[g.name, g.target, g.measured, mark[g.met]] for s in sections for g in s.goals]
-    return table(["goal", "target", "measured (median)", ""], rows) if rows else "No goals measured."
+    return table(GOAL_HEADER, rows) if rows else "No goals measured."
 
 
 def render(sections: list[Section], command: str, info: dict[str, str], wall_s: float) -> str:
@@ -103,6 +108,67 @@ def render(sections: list[Section], command: str, info: dict[str, str], wall_s: 
     return "\n".join(out)
 
 
+def _blocks(text: str) -> list[list[str]]:
+    """``text`` cut into blocks of lines, each (but the first) starting at a ``## `` heading."""
+    blocks: list[list[str]] = [[]]
+    for line in text.splitlines():
+        if line.startswith("## "):
+            blocks.append([])
+        blocks[-1].append(line)
+    return blocks
+
+
+def _goal_name(row: str) -> str:
+    return row[2:].split(" | ", 1)[0].strip()
+
+
+def _splice_goals(block: list[str], sections: list[Section]) -> list[str]:
+    """The goals block with each section's rows in place of the old rows of the same names (at
+    the first one's position; appended when none was there)."""
+    rows = [ln for ln in block if ln.startswith("| ")][1:]  # the first is the header
+    if not rows:
+        return ["## Goals", "", _goals_table(sections), ""]
+    for s in sections:
+        new = _goals_table([s]).splitlines()[2:] if s.goals else []
+        names = {_goal_name(r) for r in new}
+        first = next((i for i, r in enumerate(rows) if _goal_name(r) in names), len(rows))
+        at = sum(1 for r in rows[:first] if _goal_name(r) not in names)  # its place among the rows kept
+        kept = [r for r in rows if _goal_name(r) not in names]
+        rows = kept[:at] + new + kept[at:]
+    return ["## Goals", "", *table(GOAL_HEADER, []).splitlines(), *rows, ""]
+
+
+def splice(old: str, sections: list[Section], command: str, info: dict[str, str], wall_s: float) -> str:
+    """``old`` (a ``BENCHMARKS.md``) with the given sections replaced (or appended) and their goal
+    rows updated; a line under the run's date says which sections were run again, when and how."""
+    blocks = _blocks(old)
+    day = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    titles = ", ".join(f"*{s.title}*" for s in sections)
+    load = info.get("load average at start (1, 5, 15 min)", "?")
+    note = (f"Re-run {day}: {titles} only (`{command}`, {wall_s / 60:.1f} min; load average at start "
+            f"{load}, at end {info.get('load average at end (1, 5, 15 min)', '?')}); the other sections "
+            "are from the run above.")
+    head: list[str] = []
+    for ln in blocks[0]:  # the note of an earlier re-run of the same sections goes (and its blank line)
+        if not (ln.startswith("Re-run ") and all(f"*{s.title}*" in ln for s in sections)) and (ln or head[-1:] != [""]):
+            head.append(ln)
+    at = next((i + 1 for i, ln in enumerate(head) if ln.startswith("Run ")), len(head))
+    out = [*head[:at], "", note, *head[at:]]
+    done = set()
+    for b in blocks[1:]:
+        title = b[0][3:].strip()
+        if title == "Goals":
+            b = _splice_goals(b, sections)
+        for s in sections:
+            if s.title == title:
+                b, done = [f"## {s.title}", "", s.markdown.strip(), ""], done | {s.title}
+        out += b
+    for s in sections:
+        if s.title not in done:
+            out += [f"## {s.title}", "", s.markdown.strip(), ""]
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="small, fast versions of every benchmark")
@@ -134,7 +200,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     info["load average at end (1, 5, 15 min)"] = " ".join(f"{v:.2f}" for v in os.getloadavg())
     print("## Goals\n\n" + _goals_table(sections))
     if not args.no_write:
-        Path(args.output).write_text(render(sections, command, info, wall))
+        path = Path(args.output)
+        partial = set(chosen) != set(BENCHES) and path.exists()
+        path.write_text(splice(path.read_text(), sections, command, info, wall) if partial
+                        else render(sections, command, info, wall))
         print(f"\nwrote {args.output}")
     return 0
 

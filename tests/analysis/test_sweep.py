@@ -201,6 +201,38 @@ def test_fixed_point_sweep_on_two_workers_equals_the_serial_sweep(compass, sched
     assert dist.rows == serial.rows
 
 
+def test_a_branch_is_chunked_by_its_grid_and_equal_on_one_and_two_workers(compass):
+    """The default chunks of a branch depend on its length only (24 values: three chunks of 8,
+    each starting from the model's guess, so ``seeded`` is false at 0, 8 and 16) and the rows are
+    the same, digit for digit, in this process and on two forked workers."""
+    from amble.analysis.fixed_points import default_chunk
+
+    assert [default_chunk(n) for n in (1, 24, 200, 2000)] == [8, 8, 13, 32]
+    vals = np.linspace(0.03, 0.06, 24)
+    one = sweep(compass, "fixed-point", {"slope": vals}, workers=1, progress=False)
+    two = sweep(compass, "fixed-point", {"slope": vals}, workers=2, progress=False)
+    assert [i for i, r in enumerate(one.rows) if r["seeded"] == "false"] == [0, 8, 16]
+    assert [r["status"] for r in one.rows] == ["ok"] * 24
+    assert two.rows == one.rows
+
+
+def test_a_flip_between_two_chunks_is_located(compass):
+    """A flip whose bracketing gaits lie in different chunks (so on different ``branch`` ids) is
+    found and located where it is in one chunk; the compass gait's first period doubling lies
+    between slope 0.07 and 0.09 rad (Goswami, Thuilot & Espiau 1998). Without the system, which
+    would check that the branch runs through the chunk boundary, none is claimed there."""
+    from amble.analysis.branch_bifurcations import bifurcations
+
+    vals = [0.0745, 0.0760, 0.0772, 0.0785]  # the flip (≈ 0.0766) between the 2nd and 3rd values
+    whole = sweep(compass, "fixed-point", {"slope": vals}, chunk=4, **SYNC)
+    split = sweep(compass, "fixed-point", {"slope": vals}, chunk=2, **SYNC)
+    assert split.rows[1]["branch"] != split.rows[2]["branch"]
+    (ref,) = [b for b in bifurcations(whole, compass) if b.kind == "flip"]
+    (flip,) = [b for b in bifurcations(split, compass) if b.kind == "flip"]
+    assert 0.07 < flip.value < 0.09 and abs(flip.value - ref.value) < 1e-9
+    assert [b for b in bifurcations(split) if b.kind == "flip"] == []
+
+
 def test_a_basin_on_two_local_processes_equals_the_serial_basin(compass):
     xs = find_fixed_point(compass).fixed_point
     over = _box(("stance", "stance_dot"), ((xs[0] - 0.05, xs[0] + 0.05), (xs[2] - 0.2, xs[2] + 0.2)), (4, 4))

@@ -64,16 +64,49 @@ def _fixed_point(result: SweepResult, system: HybridSystem | None, params: Mappi
     rows = sorted(result.rows, key=lambda r: int(r["i"]))
     out: list[BifurcationPoint] = []
     for ra, rb in zip(rows, rows[1:]):
-        if ra["status"] != "ok" or rb["status"] != "ok" or ra.get("branch") != rb.get("branch"):
-            continue  # a failed point or a new branch between them: no branch joins the two
+        if ra["status"] != "ok" or rb["status"] != "ok":
+            continue  # a failed point between them: no branch joins the two
         ta, tb = multiplier_tests(_multipliers(ra)), multiplier_tests(_multipliers(rb))
-        for kind, fa, fb in zip(KINDS, ta, tb):
-            if not fa * fb < 0:
-                continue
+        crossed = [(kind, fa, fb) for kind, fa, fb in zip(KINDS, ta, tb) if fa * fb < 0]
+        if not crossed or not _one_branch(result, system, params, tol, p, ra, rb):
+            continue
+        for kind, fa, fb in crossed:
             bp = _between(result, system, params, tol, p, kind, (ra, fa), (rb, fb))
             if bp is not None:
                 out.append(bp)
     return sorted(out, key=lambda b: b.value)
+
+
+#: How close (∞-norm, in the state's units) the branch continued from one row must come to the
+#: next row's gait for the two to be one branch: far above the corrected gaits' residual (1e-12),
+#: far below the distance between distinct gaits of one parameter value.
+SAME_GAIT = 1e-7
+
+
+def _one_branch(result: SweepResult, system: HybridSystem | None, params: Mapping[str, float] | None, tol: float,
+                p: str, ra: Mapping[str, str], rb: Mapping[str, str]) -> bool:
+    """Whether two neighbouring converged rows lie on one branch: the same ``branch`` id, or —
+    with ``system`` — ``rb`` began its chunk from the model's guess (not continued from the row
+    before: a task's first point, ``seeded`` false, no ``branch_break``) and the branch continued
+    from ``ra``'s gait reaches ``rb``'s. Chunks are computed independently, so a branch that runs
+    through a chunk boundary gets a new id there without being broken."""
+    if ra.get("branch") == rb.get("branch"):
+        return True
+    if system is None or rb.get("seeded") != "false" or rb.get("branch_break"):
+        return False  # without the system, or a branch the continuation could not carry on
+    from ..errors import AmbleError
+    from .poincare import continue_fixed_point
+
+    xa, xb = (state_from_row(r, result.state_names) for r in (ra, rb))
+    if xa is None or xb is None:
+        return False
+    base = dict(params or {})
+    try:
+        lc = continue_fixed_point(system, xa, {**base, p: float(ra[p])}, {**base, p: float(rb[p])},
+                                  rtol=FIXED_POINT_TOL, atol=FIXED_POINT_TOL, tol=tol)
+    except AmbleError:
+        return False
+    return bool(np.max(np.abs(np.asarray(lc.fixed_point) - xb)) <= SAME_GAIT)
 
 
 def _between(result: SweepResult, system: HybridSystem | None, params: Mapping[str, float] | None, tol: float,
@@ -111,8 +144,9 @@ def bifurcations(result: SweepResult, system: HybridSystem | None = None, *,
     """The folds, flips and torus (Neimark–Sacker) points a sweep's branch crosses.
 
     - a fixed-point branch over one parameter (``amble.sweep(system, "fixed-point", {param: values})``):
-      between two neighbouring converged gaits of one branch (same ``branch`` id, no failure
-      between them) where ψ_fold, ψ_flip or ψ_torus changes sign, the bifurcation is located on
+      between two neighbouring converged gaits of one branch (same ``branch`` id, or — with
+      ``system`` — a chunk's first gait that the branch continued from the gait before reaches;
+      no failure between them) where ψ_fold, ψ_flip or ψ_torus changes sign, the bifurcation is located on
       the branch with ``system`` (and ``params``, the sweep's other parameters; ``tol`` the
       residual of each corrected gait), in order of the parameter; without the system, the
       bracketing grid point with the smaller |ψ| stands for it (``located=False``);

@@ -117,13 +117,25 @@ def _fp_sweep(system: HybridSystem, pnames: list[str], grid: list[tuple[int, int
                      params=pnames, state_names=snames, run=run)
 
 
+def default_chunk(points: int) -> int:
+    """Values per task of a branch of ``points`` values: about a sixteenth of the branch, at
+    least 8 and at most 32.
+
+    A function of the grid only (never of the workers), so a result does not depend on where it
+    ran. Sixteen or more tasks keep two to four workers busy to the end (seven tasks of 32 values,
+    a 200-point branch before, left one of two workers idle for most of a task); 8 values or
+    more keep the warm start (each point continued from the one before) doing most of the work."""
+    return min(32, max(8, -(-int(points) // 16)))
+
+
 def fixed_point_kind(system: HybridSystem, over: Mapping[str, np.ndarray], params: Mapping[str, float] | None,
                      run: RunOptions, *, warm_start: bool = True, chunk: int | None = None,
                      tol: float = RESIDUAL_TOL) -> SweepResult:
     """The ``fixed-point`` kind of :func:`amble.sweep`: the period-1 fixed point of the return map
     at every value of one parameter (a branch), or on the grid of two (a map).
 
-    One parameter: each chunk of ``chunk`` (default 32) consecutive values is one Dask task; inside
+    One parameter: each chunk of ``chunk`` consecutive values is one task (default
+    :func:`default_chunk`: a sixteenth of the branch, 8 to 32 values); inside
     it the gait at one value is continued along its branch to the next (``warm_start=False``:
     every point from the model's guess). A point the branch does not reach is searched from the
     model's guess and, if found, starts a new branch; one with no gait is recorded ``failed`` with
@@ -142,7 +154,7 @@ def fixed_point_kind(system: HybridSystem, over: Mapping[str, np.ndarray], param
     fp_kw = {"rtol": run.rtol, "atol": run.atol, "tol": tol}
     names = list(over)
     if len(names) == 1:
-        size = 32 if chunk is None else chunk
+        size = default_chunk(len(over[names[0]])) if chunk is None else chunk
         if size < 1:
             raise StateError(f"chunk must be at least 1, got {size}")
         grid = [(i, 0, (float(x),)) for i, x in enumerate(over[names[0]])]
@@ -175,7 +187,7 @@ def sweep_fixed_points(
     params: Mapping[str, float] | None = None,
     warm_start: bool = True,
     continuation: bool | None = None,
-    chunk: int = 32,
+    chunk: int | None = None,
     out: str | os.PathLike | None = None,
     scheduler: Any = None,
     workers: int | None = None,
