@@ -35,22 +35,27 @@ def test_the_compass_gaits_norm_is_that_of_simulated_disturbed_walks():
     s = load_model("compass-gait")
     lc = find_fixed_point(s)
     g = gait_sensitivity(lc, "slope")
-    d = 1e-6
+    state, step_time = _disturbed_walks(s, lc, "slope", g.steps)
+    assert g.state == pytest.approx(state, rel=1e-4)
+    assert g.step_time == pytest.approx(step_time, rel=1e-4)
+
+
+def _disturbed_walks(s, lc, name: str, steps: int, d: float = 1e-6) -> tuple[float, float]:
+    """The norms of the response of simulated walks to one step with ``name`` ± ``d`` and
+    ``steps`` undisturbed steps after it, differenced centrally: (state, step time)."""
     P = ReturnMap(s, lc.parameters)
     resp = {}
     for sign in (1, -1):
-        Pd = ReturnMap(s, {**lc.parameters, "slope": lc.parameters["slope"] + sign * d})
-        x, t = Pd(lc.fixed_point)
+        x, t = ReturnMap(s, {**lc.parameters, name: lc.parameters[name] + sign * d})(lc.fixed_point)
         xs, ts = [x], [t]
-        for _ in range(g.steps):
+        for _ in range(steps):
             x, t = P(x)
             xs.append(x)
             ts.append(t)
         resp[sign] = np.array(xs), np.array(ts)
     dx = (resp[1][0] - resp[-1][0]) / (2 * d)
     dt = (resp[1][1] - resp[-1][1]) / (2 * d)
-    assert g.state == pytest.approx(math.sqrt(float(np.sum(dx**2))), rel=1e-4)
-    assert g.step_time == pytest.approx(math.sqrt(float(np.sum(dt**2))), rel=1e-4)
+    return math.sqrt(float(np.sum(dx**2))), math.sqrt(float(np.sum(dt**2)))
 
 
 def test_an_unknown_parameter_is_refused():
@@ -113,19 +118,7 @@ def test_the_compass_gaits_norm_for_a_step_down_is_that_of_disturbed_walks():
     s = _compass_with_a_step()
     lc = find_fixed_point(s)
     g = gait_sensitivity(lc, "step")
-    d = 1e-6
-    P = ReturnMap(s, lc.parameters)
-    resp = {}
-    for sign in (1, -1):
-        x, t = ReturnMap(s, {**lc.parameters, "step": sign * d})(lc.fixed_point)
-        xs, ts = [x], [t]
-        for _ in range(g.steps):
-            x, t = P(x)
-            xs.append(x)
-            ts.append(t)
-        resp[sign] = np.array(xs), np.array(ts)
-    dx = (resp[1][0] - resp[-1][0]) / (2 * d)
-    dt = (resp[1][1] - resp[-1][1]) / (2 * d)
-    assert g.state == pytest.approx(math.sqrt(float(np.sum(dx**2))), rel=1e-4)
-    assert g.step_time == pytest.approx(math.sqrt(float(np.sum(dt**2))), rel=1e-4)
+    state, step_time = _disturbed_walks(s, lc, "step", g.steps)
+    assert g.state == pytest.approx(state, rel=1e-4)
+    assert g.step_time == pytest.approx(step_time, rel=1e-4)
     assert g.state > 1.0  # a centimetre's step moves the gait by centimetres: not a vanishing response

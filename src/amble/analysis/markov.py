@@ -45,12 +45,9 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.kernels import compiled
 from ..errors import ParameterError
 from ..simulation.engine import CODE, Options, walk_many
-from ..simulation.simulate import parameter_vector
-from .mfpt import Terrain
-from .poincare import find_fixed_point
+from .mfpt import Terrain, terrain_start
 
 #: sections with at most this many varying coordinates are interpolated linearly (Delaunay)
 LINEAR_MAX_DIM = 3
@@ -308,18 +305,7 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
             raise ParameterError(f"{name} must be an integer ≥ {low}, got {v!r}")
     if not (isinstance(spacing, (int, float)) and math.isfinite(spacing) and spacing > 0):
         raise ParameterError(f"spacing must be a number > 0, got {spacing!r}")
-    k = compiled(system)
-    names = list(k.meta["params"])
-    unknown = [n for n in terrain.draws if n not in names]
-    if unknown:
-        raise ParameterError(f"terrain draws {', '.join(map(repr, unknown))}: not parameters of {system.name!r}")
-    base = {**(params or {}), **terrain.mean()}
-    p0 = parameter_vector(k, base, system)
-    if start is None:
-        lc = find_fixed_point(system, params=base)
-        x0, mode = np.asarray(lc.fixed_point, float), k.mode_index(lc.mode)
-    else:
-        x0, mode = np.asarray(start, float), 0
+    k, names, p0, x0, mode = terrain_start(system, terrain, params, start)
     draws, weights = quadrature(terrain, nodes)
     one = next(iter(terrain.draws.values()))
     law = _law(*one) if len(terrain.draws) == 1 and not _fixed(*one) else None

@@ -122,6 +122,24 @@ def _rate_interval(falls: int, steps: int, confidence: float) -> tuple[float, fl
     return float(low), float(high)
 
 
+def terrain_start(system: Any, terrain: Terrain, params: Mapping[str, float] | None,
+                  start: Sequence[float] | None) -> tuple[Any, list[str], np.ndarray, np.ndarray, int]:
+    """The compiled kernels, their parameter names, the parameter vector at the terrain's mean
+    (``params`` for the rest) and the walkers' first post-impact state and mode: ``start``, else
+    the gait at the terrain's mean. A terrain drawing a name that is no parameter is refused."""
+    k = compiled(system)
+    names = list(k.meta["params"])
+    unknown = [n for n in terrain.draws if n not in names]
+    if unknown:
+        raise ParameterError(f"terrain draws {', '.join(map(repr, unknown))}: not parameters of {system.name!r}")
+    base = {**(params or {}), **terrain.mean()}
+    p0 = parameter_vector(k, base, system)
+    if start is None:
+        lc = find_fixed_point(system, params=base)
+        return k, names, p0, np.asarray(lc.fixed_point, float), k.mode_index(lc.mode)
+    return k, names, p0, np.asarray(start, float), 0
+
+
 def mfpt(system: Any, terrain: Terrain, *, runs: int = 1000, max_steps: int = 1000, seed: int = 0,
          params: Mapping[str, float] | None = None, start: Sequence[float] | None = None,
          confidence: float = 0.95, threads: int = 1, opts: Options | None = None) -> FirstPassage:
@@ -135,18 +153,7 @@ def mfpt(system: Any, terrain: Terrain, *, runs: int = 1000, max_steps: int = 10
             raise ParameterError(f"{name} must be an integer ≥ {low}, got {v!r}")
     if not 0 < confidence < 1:
         raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
-    k = compiled(system)
-    names = list(k.meta["params"])
-    unknown = [n for n in terrain.draws if n not in names]
-    if unknown:
-        raise ParameterError(f"terrain draws {', '.join(map(repr, unknown))}: not parameters of {system.name!r}")
-    base = {**(params or {}), **terrain.mean()}
-    p0 = parameter_vector(k, base, system)
-    if start is None:
-        lc = find_fixed_point(system, params=base)
-        x0, mode = np.asarray(lc.fixed_point, float), k.mode_index(lc.mode)
-    else:
-        x0, mode = np.asarray(start, float), 0
+    k, names, p0, x0, mode = terrain_start(system, terrain, params, start)
     rng = np.random.default_rng(seed)
     cols = [names.index(n) for n in terrain.draws]
     X = np.tile(x0, (runs, 1))
