@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .sweep_plots import _label, _plt, _save
+from .sweep_plots import _plt, _save, branch_axes
 
 if TYPE_CHECKING:
     from ..analysis.doublings import Cascade
@@ -60,14 +60,7 @@ def plot_cascade(cascade: Cascade, path: str | os.PathLike, *, coordinate: str |
         a2.axvline(f.value, color="0.6", lw=0.8)
     if cascade.flips:
         a1.plot([], [], "o", color="k", ms=4, label="period doubling (μ = −1)")
-    a2.axhline(1.0, ls="--", color="k", lw=1)
-    a2.set_yscale("log")
-    a1.set_ylabel(f"post-impact {_label(coordinate)}" if coordinate else "post-impact state")
-    a1.legend(fontsize=8)
-    a1.grid(alpha=0.3)
-    a2.set_ylabel("largest |μ| (1)")
-    a2.set_xlabel(_label(cascade.param))
-    a2.grid(alpha=0.3, which="both")
+    branch_axes(a1, a2, coordinate, cascade.param)
     a1.set_title(title or "Period-doubling cascade")
     return _save(fig, path)
 

@@ -33,6 +33,19 @@ def _plt():
     return plt
 
 
+def branch_axes(a1: Any, a2: Any, coordinate: str | None, param: str) -> None:
+    """Label a branch figure's two axes: the post-impact ``coordinate`` over the parameter above,
+    the largest multiplier modulus (log scale, the stability line |μ| = 1 dashed) below."""
+    a2.axhline(1.0, ls="--", color="k", lw=1)
+    a2.set_yscale("log")
+    a1.set_ylabel(f"post-impact {_label(coordinate)}" if coordinate else "post-impact state")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    a2.set_ylabel("largest |μ| (1)")
+    a2.set_xlabel(_label(param))
+    a2.grid(alpha=0.3, which="both")
+
+
 def _label(name: str) -> str:
     unit = UNITS.get(name)
     if unit is None:
@@ -241,14 +254,7 @@ def plot_continuation(result: Any, path: str | os.PathLike, *, coordinate: str |
         a1.plot([], [], "^", color="k", ms=5, label="fold (μ = +1)")
     if "torus" in kinds:
         a1.plot([], [], "s", color="k", ms=5, label="torus (Neimark–Sacker, |μ| = 1, μ complex)")
-    a2.axhline(1.0, ls="--", color="k", lw=1)
-    a2.set_yscale("log")
-    a1.set_ylabel(f"post-impact {_label(coord)}" if coord else "post-impact state")
-    a1.legend(fontsize=8)
-    a1.grid(alpha=0.3)
-    a2.set_ylabel("largest |μ| (1)")
-    a2.set_xlabel(_label(pname))
-    a2.grid(alpha=0.3, which="both")
+    branch_axes(a1, a2, coord, pname)
     a1.set_title(title or "Continuation: branches of gaits, stability and bifurcations")
     return _save(fig, path)
 
