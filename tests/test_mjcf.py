@@ -23,6 +23,7 @@ from amble.backend.kernels import build
 from amble.errors import ModelError
 
 mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is the reference; not installed")
+from oracles.mujoco_dynamics import full_mass_matrix  # noqa: E402  (after the skip)
 
 DATA = Path(__file__).parent / "data"
 REL = 1e-10
@@ -116,15 +117,6 @@ class _Map:
         return (self.jacobian(q + 1j * h * v) @ v).imag / h
 
 
-def _full_mass_matrix(m, d) -> np.ndarray:
-    out = np.zeros((m.nv, m.nv))
-    try:
-        mujoco.mj_fullM(m, d, out)  # MuJoCo 4
-    except TypeError:
-        mujoco.mj_fullM(m, out, d.qM)  # MuJoCo 3
-    return out
-
-
 def _compare(path: Path, states: int = 20, fixed_base: bool = False, seed: int = 5) -> dict[str, float]:
     model = Model.from_mjcf(path, fixed_base=fixed_base)
     k = build(HybridSystem(model.name, model))
@@ -147,7 +139,7 @@ def _compare(path: Path, states: int = 20, fixed_base: bool = False, seed: int =
         q, v = rng.uniform(-1.2, 1.2, n), rng.uniform(-2.0, 2.0, n)
         d.qpos[:], d.qvel[:] = mp.qpos_qvel(q, v)
         mujoco.mj_forward(m, d)
-        Mm = _full_mass_matrix(m, d)
+        Mm = full_mass_matrix(m, d)
         J, Jdv = mp.jacobian(q).real, mp.jdot_v(q, v)
         x = np.concatenate([q, v])
         M, h, G = k.dynamics(0, 0.0, x, np.zeros(1))
@@ -230,7 +222,7 @@ def test_a_linear_joint_coupling_is_a_mimic_joint_checked_against_mujoco_project
         d.qpos[:] = G @ a + np.array([0.0, cc, 0.0])
         d.qvel[:] = G @ v
         mujoco.mj_forward(m, d)
-        Mm = _full_mass_matrix(m, d)
+        Mm = full_mass_matrix(m, d)
         M, h, Gam = k.dynamics(0, 0.0, np.concatenate([a, v]), np.zeros(1))
         rel = lambda x, y: float(np.abs(x - y).max() / np.abs(y).max())
         assert rel(M, G.T @ Mm @ G) <= REL

@@ -24,19 +24,11 @@ from amble.models import load
 from amble.simulation.simulate import parameter_vector
 
 mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is the reference; not installed")
+from oracles.mujoco_dynamics import full_mass_matrix  # noqa: E402  (after the skip)
 
 #: amble's coordinates (torso stance_hip swing_hip stance_knee swing_knee) → MuJoCo's velocity index
 #: while leg a stands (MuJoCo: rootx rootz torso hip_a knee_a hip_b knee_b), written out here
 _ROWS = [2, 3, 5, 4, 6]
-
-
-def _full_mass_matrix(m, d) -> np.ndarray:
-    out = np.zeros((m.nv, m.nv))
-    try:
-        mujoco.mj_fullM(m, d, out)  # MuJoCo 4
-    except TypeError:
-        mujoco.mj_fullM(m, out, d.qM)  # MuJoCo 3
-    return out
 
 
 @pytest.fixture(scope="module")
@@ -72,7 +64,7 @@ def test_exported_dynamics_are_amble_s(rabbit, seed):
     mujoco.mj_jacDot(m, d, dp, dr, d.site_xpos[site], body)
     a = np.zeros(m.nv)
     a[:2] = -(dp[[0, 2]] @ d.qvel)
-    Mmj = _full_mass_matrix(m, d)
+    Mmj = full_mass_matrix(m, d)
     M, h, _ = k.dynamics("rabbit", 0.0, x, p)
     scale = np.max(np.abs(M))
     np.testing.assert_allclose(J.T @ Mmj @ J, M, rtol=0, atol=1e-10 * scale)
