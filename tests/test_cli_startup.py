@@ -30,11 +30,16 @@ NOT_ON_THE_WARM_PATH = (
     "amble.backend.runtime", "amble.backend.codegen", "amble.derivation", "amble.modelling.hybrid",
 )
 
-_MODULES = "import json, sys; {run}print(json.dumps(sorted(sys.modules)), file=sys.stderr)"
+#: Python's start-up may already import some of them (a ``.pth`` file of the environment, e.g. one
+#: that installs certificates imports ``tempfile``): the child forgets those first, so they count
+#: only if the run imports them again.
+_FORGET = ("hashlib", "shutil", "subprocess", "tempfile", "pkgutil")
+_MODULES = ("import json, sys; [sys.modules.pop(m, None) for m in {forget!r}]; {run}"
+            "print(json.dumps(sorted(sys.modules)), file=sys.stderr)")
 
 
 def _modules(run: str, env: dict[str, str]) -> set[str]:
-    r = subprocess.run([sys.executable, "-c", _MODULES.format(run=run)], env=env, capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-c", _MODULES.format(forget=_FORGET, run=run)], env=env, capture_output=True, text=True,
                        timeout=600)
     assert r.returncode == 0, r.stderr
     return set(json.loads(r.stderr.strip().splitlines()[-1]))

@@ -27,7 +27,6 @@ import errno
 import io
 import math
 import os
-import tempfile
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -111,6 +110,8 @@ class ResultStore:
             return
         where = self.final.parent if str(self.final.parent) else Path(".")
         try:  # a real file, not permission bits: also right for root and read-only file systems
+            import tempfile  # here, not at import: a warm run that writes no file never needs it
+
             fd, probe = tempfile.mkstemp(prefix=f".{self.final.name}.", suffix=".probe", dir=where)
             os.close(fd)
             os.unlink(probe)
