@@ -39,8 +39,8 @@ _MODULES = ("import json, sys; [sys.modules.pop(m, None) for m in {forget!r}]; {
 
 
 def _modules(run: str, env: dict[str, str]) -> set[str]:
-    r = subprocess.run([sys.executable, "-c", _MODULES.format(forget=_FORGET, run=run)], env=env, capture_output=True, text=True,
-                       timeout=600)
+    code = _MODULES.format(forget=_FORGET, run=run)
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     return set(json.loads(r.stderr.strip().splitlines()[-1]))
 
