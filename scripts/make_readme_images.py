@@ -1,5 +1,6 @@
 """Render the README pictures: each thesis robot in the 3D viewer (headless Chromium), the
-compass gait's limit cycle, and Bolt (example-robot-data) with its meshes for the URDF guide. Run from the repository root: ``python scripts/make_readme_images.py``."""
+compass gait's limit cycle, and Bolt (example-robot-data) with its meshes for the URDF guide.
+Run from the repository root: ``python scripts/make_readme_images.py``."""
 
 import subprocess
 import tempfile
