@@ -41,6 +41,7 @@ from .mfpt import add_parser as add_mfpt_parser
 from .mujoco import EXAMPLE as MUJOCO_EXAMPLE
 from .mujoco import add_parser as add_mujoco_parser
 from .output import gait_check_lines, write_output
+from .prefetch import prefetch_plotting
 from .robustness import EXAMPLE as ROBUSTNESS_EXAMPLE
 from .robustness import add_parser as add_robustness_parser
 
@@ -355,7 +356,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     s.add_argument("--method", choices=METHODS, default="dop853",
                    help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
                         "tsit5 (explicit, 5th order)")
-    s.set_defaults(func=cmd_simulate)
+    s.set_defaults(func=cmd_simulate, plots_in_process=True)
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)
     lc.add_argument("--period", type=int, default=1,
@@ -367,7 +368,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
-    lc.set_defaults(func=cmd_limit_cycle)
+    lc.set_defaults(func=cmd_limit_cycle, plots_in_process=True)
     sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
                       "on local worker processes or Dask")
     model_args(sw, None)
@@ -444,7 +445,14 @@ def _main(argv: list[str]) -> int:
         # only the command named first is built (--help, --version and mistakes get the whole parser)
         first = argv[0] if argv and argv[0] in EXAMPLES and not {"-h", "--help"} & set(argv) else None
         args = build_parser(first).parse_args(argv)
-        result = args.func(args)
+        # only for commands that start no worker processes: a fork while a thread holds an import
+        # lock could leave the child waiting on it
+        plotting = prefetch_plotting() if getattr(args, "plots_in_process", False) and args.plot else None
+        try:
+            result = args.func(args)
+        finally:
+            if plotting is not None:  # not cut short at exit
+                plotting.join()
         if args.json:
             print(json.dumps(result, default=_jsonable))
         sys.stdout.flush()  # a closed pipe is found here, not at interpreter exit

@@ -135,11 +135,11 @@ def _mesh_parts(shapes: Sequence[Shape], poses: Mapping[str, tuple[np.ndarray, n
     """The scene's ``poses`` (``[x, y, z, qx, qy, qz, qw]`` per frame, the rotation as a unit
     quaternion) and ``meshes`` used by :class:`Mesh` shapes, and the world positions ``(F, 3)`` of
     the corners of each mesh's bounding box (for the bounds and the robot's size)."""
-    from scipy.spatial.transform import Rotation
-
     used = [s for s in shapes if isinstance(s, Mesh)]
     if not used:
         return {}, []
+    from scipy.spatial.transform import Rotation  # here: importing it costs ~1 s, needed for meshes only
+
     out_poses: dict[str, list[float]] = {}
     corners: list[np.ndarray] = []
     for s in used:
