@@ -379,9 +379,10 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
     s.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
     s.add_argument("--limits", choices=LIMIT_ACTIONS, default="ignore",
-                   help="what a joint reaching a limit of its range (a robot file's <limit>, MJCF range) does: "
+                   help="what a joint reaching a limit of its range (a URDF joint limit, an MJCF range) does: "
                         "ignore (default: it passes, as if unlimited) or stop (the run ends there, status "
-                        "joint_limit, reporting the coordinate, the bound and the time)")
+                        "joint_limit, reporting the coordinate, the bound and the time; in --json the field 'limit'), "
+                        "e.g. amble simulate tests/data/pendulum.urdf --fixed-base --limits stop")
     s.add_argument("--method", choices=METHODS, default="dop853",
                    help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
                         "tsit5 (explicit, 5th order)")
