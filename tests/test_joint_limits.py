@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 
 import pytest
 from oracles.pendulum import omega2, speed_at_angle, time_by_integration, time_to_angle
@@ -58,6 +59,23 @@ def test_a_pendulum_stops_at_its_limit_at_the_closed_form_time(tmp_path, axis, l
     sign = 1.0 if bound == "upper" else -1.0
     assert abs(event.x_pre[0] - sign * A) < 1e-10
     assert abs(event.x_pre[1] - sign * speed_at_angle(A, W2)) < 1e-8
+
+
+def test_where_a_start_on_or_beyond_a_bound_stops(tmp_path):
+    """On a bound moving out: at once. On the lower bound at rest, gravity pulling in: not there
+    but at the upper bound. Beyond the upper bound moving in: not when it enters, but when it
+    swings back out through the bound."""
+    system = load_robot(_urdf(tmp_path, "0 1 0", f'<limit lower="-0.5" upper="{A}" effort="1" velocity="1"/>'),
+                        fixed_base=True, limits="stop")
+    out = simulate(system, [-0.5, -0.1], t_end=1.0, samples=False)
+    assert out.status == "joint_limit" and limit_of(out.events[-1].name) == ("hinge", "lower")
+    assert out.events[-1].t < 1e-12
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no zero-time event at the lower bound
+        rest = simulate(system, [-0.5, 0.0], t_end=2.0, samples=False)
+    assert limit_of(rest.events[-1].name) == ("hinge", "upper") and len(rest.events) == 1
+    back = simulate(system, [A + 0.2, -3.0], t_end=2.0, samples=False)
+    assert limit_of(back.events[-1].name) == ("hinge", "upper") and back.events[-1].x_pre[1] > 0
 
 
 def test_guards_are_the_distances_to_the_bounds_and_ignore_is_todays_run(tmp_path):

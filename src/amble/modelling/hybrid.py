@@ -138,19 +138,19 @@ class HybridSystem(Revised):
         in and crosses a bound again; one started on a bound and moving out stops at once.
         Returns the transitions added (none, with a warning, if no mode has a limited joint)."""
         names = list(self.modes) if modes is None else [modes] if isinstance(modes, str) else list(modes)
-        taken = {tr.name for tr in self.transitions}
-        added = []
         for mode in names:
             self._check_mode(mode)
-            for lg in self.modes[mode].limit_guards():
-                name = transition_name(lg, None if len(self.modes) == 1 else mode)
-                if name in taken:
-                    raise ModelError(f"system {self.name!r}: a transition named {name!r} exists already")
-                taken.add(name)
-                added.append(self.terminal(name, mode, lg.guard, status=status))
-        if not added:
+        planned = [(transition_name(lg, None if len(self.modes) == 1 else mode), mode, lg.guard)
+                   for mode in names for lg in self.modes[mode].limit_guards()]
+        # every name checked before any is added: a refused call leaves the system as it was
+        taken = {tr.name for tr in self.transitions}
+        for name, _, _ in planned:
+            if name in taken:
+                raise ModelError(f"system {self.name!r}: a transition named {name!r} exists already")
+            taken.add(name)
+        if not planned:
             warnings.warn(f"system {self.name!r}: no joint has a limit, so no run stops at one", stacklevel=2)
-        return added
+        return [self.terminal(name, mode, guard, status=status) for name, mode, guard in planned]
 
     @declaration
     def add_mode(self, name: str, model: Model) -> None:
