@@ -104,7 +104,8 @@ def test_no_source_file_is_too_long(suffix):
 _READS = {
     "Names": {"symbol_table", "parse", "domain", "unit", "dot", "symbol"},
     "Actuators": {"input_unit", "input_matrix", "dynamics", "mass_and_bias"},
-    "Model": {"dt", "diff", "jacobian", "point_jacobian", "point_velocity", "from_urdf", "constrained", "validate"},
+    "Model": {"dt", "diff", "jacobian", "point_jacobian", "point_velocity", "from_urdf", "constrained", "validate",
+              "limit_guards"},
     "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names", "full", "symbolic"},
     "Walker": {"slope_value", "frame_change"},
 }

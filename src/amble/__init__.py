@@ -29,6 +29,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("R3", "R", "Rx", "Ry", "Rz", "t", "vector"), ".modelling.geometry"),
     **dict.fromkeys(("Explicit", "Guard", "HybridSystem", "Impact", "Lock"), ".modelling.hybrid"),
     "Model": ".modelling.model",
+    **dict.fromkeys(("LimitGuard", "limit_of"), ".modelling.limits"),
     "sample_and_hold": ".modelling.sampled",
     "parse": ".modelling.text",
     **dict.fromkeys(("base_relabel", "stance_feet_walker"), ".modelling.stance_feet"),
@@ -122,6 +123,7 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
     from .modelling.domain import NONNEGATIVE, POSITIVE, Domain, interval  # noqa: F401
     from .modelling.geometry import R3, R, Rx, Ry, Rz, t, vector  # noqa: F401
     from .modelling.hybrid import Explicit, Guard, HybridSystem, Impact, Lock  # noqa: F401
+    from .modelling.limits import LimitGuard, limit_of  # noqa: F401
     from .modelling.model import Model  # noqa: F401
     from .modelling.sampled import sample_and_hold  # noqa: F401
     from .modelling.stance_feet import base_relabel, stance_feet_walker  # noqa: F401

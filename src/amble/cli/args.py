@@ -134,7 +134,7 @@ def robot_options(args: Any) -> dict[str, Any]:
 
 
 def load_model(name: str, *, compiled: bool = False, derivatives: bool = False, base: str | None = None,
-               fixed_base: bool = False):
+               fixed_base: bool = False, limits: str = "ignore"):
     """A library model by name, the system of a model file ``path/to/file.py[:callable]``, or the
     robot of a URDF file (``base``, ``fixed_base``: :func:`amble.models.load_robot`).
 
@@ -145,27 +145,48 @@ def load_model(name: str, *, compiled: bool = False, derivatives: bool = False, 
 
     A model file that calls ``sys.exit()`` while it is loaded, or a path the operating system
     cannot look up (too long, a NUL byte), is a :class:`~amble.errors.ModelError`: the command
-    would otherwise end with the file's exit code and no output, or with an internal error."""
+    would otherwise end with the file's exit code and no output, or with an internal error.
+
+    ``limits="stop"``: the run ends where a joint reaches a limit of its range
+    (:meth:`~amble.modelling.hybrid.HybridSystem.stop_at_limits`); a system without any is
+    loaded as it is, with a warning."""
+    from ..modelling.limits import limit_of  # no SymPy: a warm start stays light
     from ..models import is_file_spec, is_robot_file
 
     if is_robot_file(name):
         _check_model_path(name)
-        return _load_robot(name, base, fixed_base, compiled, derivatives)
-    if is_file_spec(name):
-        _check_model_path(name)
-    return _load(name, compiled, derivatives)  # a file's sys.exit() is load_file's ModelError
+        system = _load_robot(name, base, fixed_base, compiled, derivatives, limits)
+    else:
+        if is_file_spec(name):
+            _check_model_path(name)
+        # the limits' terminals change the system: built from its declaration, not the warm index
+        system = _load(name, compiled and limits == "ignore", derivatives)  # a file's sys.exit() is a ModelError
+        if limits == "stop":
+            import warnings
+
+            with warnings.catch_warnings():  # said once below, for a robot file and a model alike
+                warnings.simplefilter("ignore")
+                system.stop_at_limits()
+    if limits == "stop" and not any(limit_of(tr.name) for tr in system.transitions):
+        import warnings
+
+        warnings.warn(f"--limits stop: {_shown(name)} has no joint with a limit; the run is not stopped at any",
+                      stacklevel=2)
+    return system
 
 
-def _load_robot(path: str, base: str | None, fixed_base: bool, compiled: bool, derivatives: bool):
+def _load_robot(path: str, base: str | None, fixed_base: bool, compiled: bool, derivatives: bool,
+                limits: str = "ignore"):
     from ..models import load_robot, source_files
 
-    build = functools.partial(load_robot, path, base=base, fixed_base=fixed_base)
+    build = functools.partial(load_robot, path, base=base, fixed_base=fixed_base, limits=limits)
     if not compiled:
         return build()
     from ..backend import index
 
-    # the options shape the system: each choice of base is an index entry of its own
-    spec, sources = f"{path}?base={base or ''}&fixed={int(fixed_base)}", source_files(path)
+    # the options shape the system: each choice of base (and of what limits do) is an index entry of its own
+    stop = "" if limits == "ignore" else f"&limits={limits}"
+    spec, sources = f"{path}?base={base or ''}&fixed={int(fixed_base)}{stop}", source_files(path)
     hit = index.lookup(spec, sources, build, derivatives)
     if hit is not None:
         return hit

@@ -19,6 +19,7 @@ from typing import Any
 
 from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, RESIDUAL_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
+from ..models import LIMIT_ACTIONS
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
 from .args import (
     UsageError,
@@ -98,7 +99,8 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--time must be positive, got {args.time}")
     drawn = bool(plot_p or anim_p)
     derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
-    s = load_model(args.model, compiled=not drawn, derivatives=derivatives, **robot_options(args))
+    s = load_model(args.model, compiled=not drawn, derivatives=derivatives, limits=args.limits,
+                   **robot_options(args))
     if out_p and (any(m.inputs for m in s.modes.values()) or getattr(s, "hip", None) is not None):
         s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
     params = parse_sets(args.set)
@@ -111,6 +113,8 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     tr = simulate(s, x0, params=params, steps=steps, t_end=t_end, rtol=args.rtol, atol=args.atol,
                   sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
     summary = tr.summary()
+    if args.limits != "ignore":
+        summary["limit"] = _limit_reached(tr)
     if out_p:
         from ..analysis.trajectory_physics import physics_columns
 
@@ -128,6 +132,10 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
         summary["animation"] = str(anim_p)
     if not args.json:
         print(f"{args.model}: {tr.status} — {tr.message}")
+        hit = summary.get("limit")
+        if hit is not None:
+            print(f"joint limit: {hit['coordinate']} reached its {hit['bound']} limit at t = {hit['t']:.12g} s "
+                  f"({hit['coordinate']} = {hit['position']:.12g})")
         post = summary["final_post_impact_state"]
         if post is not None:
             print("post-impact state: " + ", ".join(f"{n}={v:.6g}" for n, v in zip(summary["state_names"], post)))
@@ -135,6 +143,24 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
             if k in summary:
                 print(f"wrote {summary[k]}")
     return summary
+
+
+def _limit_reached(tr: Any) -> dict[str, Any] | None:
+    """The joint limit a run ended at (``--limits stop``): the coordinate, the bound (``lower``
+    or ``upper``), the event time ``t`` (s) and the coordinate's value there; ``None`` if the
+    run ended otherwise."""
+    from ..modelling.limits import STATUS, limit_of
+
+    if tr.status != STATUS or not len(tr.events):
+        return None
+    event = tr.events[-1]
+    hit = limit_of(event.name)
+    if hit is None:
+        return None
+    coordinate, bound = hit
+    position = float(event.x_pre[tr.state_names(event.source).index(coordinate)])
+    return {"coordinate": coordinate, "bound": bound, "t": float(event.t), "position": position,
+            "transition": event.name}
 
 
 def _series(values: list[str] | None, anim_p: Any) -> Any:
@@ -353,6 +379,11 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
     s.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
+    s.add_argument("--limits", choices=LIMIT_ACTIONS, default="ignore",
+                   help="what a joint reaching a limit of its range (a URDF joint limit, an MJCF range) does: "
+                        "ignore (default: it passes, as if unlimited) or stop (the run ends there, status "
+                        "joint_limit, reporting the coordinate, the bound and the time; in --json the field 'limit'), "
+                        "e.g. amble simulate tests/data/pendulum.urdf --fixed-base --limits stop")
     s.add_argument("--method", choices=METHODS, default="dop853",
                    help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
                         "tsit5 (explicit, 5th order)")

@@ -39,6 +39,7 @@ from ..errors import ModelError, ParameterError
 from .dag import free_symbols
 from .expressions import checked_expr
 from .geometry import t as _TIME
+from .limits import STATUS, transition_name
 from .model import Model
 from .revision import Revised, declaration
 from .text import expr_of, parse
@@ -122,6 +123,34 @@ class HybridSystem(Revised):
             self.transitions.append(tr)
         assert tr is not None
         return tr
+
+    @declaration
+    def stop_at_limits(self, modes: str | Sequence[str] | None = None, status: str = STATUS) -> list[Transition]:
+        """End the run where a joint reaches a limit of its range: one terminal transition per
+        finite bound of each limited coordinate (:meth:`Model.limit_guards`) in each of ``modes``
+        (default: every mode), ending the run with ``status`` (default ``"joint_limit"``).
+
+        Each is named ``<coordinate>_<bound>_limit`` (``<bound>``: ``lower`` or ``upper``;
+        followed by ``@<mode>`` in a system of several modes); :func:`amble.limit_of` reads the
+        coordinate and the bound back from the name of the run's last event. The event time is
+        located like any guard's (to the run's event tolerance); the event's ``x_pre`` is the
+        state at the limit. A joint started outside its range is stopped only if it comes back
+        in and crosses a bound again; one started on a bound and moving out stops at once.
+        Returns the transitions added (none, with a warning, if no mode has a limited joint)."""
+        names = list(self.modes) if modes is None else [modes] if isinstance(modes, str) else list(modes)
+        for mode in names:
+            self._check_mode(mode)
+        planned = [(transition_name(lg, None if len(self.modes) == 1 else mode), mode, lg.guard)
+                   for mode in names for lg in self.modes[mode].limit_guards()]
+        # every name checked before any is added: a refused call leaves the system as it was
+        taken = {tr.name for tr in self.transitions}
+        for name, _, _ in planned:
+            if name in taken:
+                raise ModelError(f"system {self.name!r}: a transition named {name!r} exists already")
+            taken.add(name)
+        if not planned:
+            warnings.warn(f"system {self.name!r}: no joint has a limit, so no run stops at one", stacklevel=2)
+        return [self.terminal(name, mode, guard, status=status) for name, mode, guard in planned]
 
     @declaration
     def add_mode(self, name: str, model: Model) -> None:

@@ -34,6 +34,7 @@ from .domain import POSITIVE
 from .expressions import checked_expr as _expr
 from .expressions import checked_matrix as _matrix
 from .geometry import t
+from .limits import LimitGuard, limit_guards
 from .revision import declaration
 from .text import expr_of
 from .tree import RigidTree
@@ -176,6 +177,13 @@ class Model(Actuators):
         if self.tree is None:
             self.tree = RigidTree(self)
         return self.tree
+
+    def limit_guards(self) -> list[LimitGuard]:
+        """The joint limits of the model's rigid-body tree as guards: for each coordinate with a
+        finite bound, ``q − lower`` and ``upper − q`` (rad or m), positive inside the range and
+        firing where they cross zero from positive; none for a mimic or continuous joint or a
+        model without a tree — see :mod:`amble.modelling.limits`."""
+        return limit_guards(self)
 
     @classmethod
     def from_urdf(cls, path: Any, base: str | None = None, contact_points: Any = None,

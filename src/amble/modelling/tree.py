@@ -172,6 +172,8 @@ class RigidTree:
         self.point_velocities: dict[str, sp.Matrix] = {}
         #: the body of each named point and its offset from the body origin (world axes, named)
         self.point_frames: dict[str, tuple[Body, sp.Matrix]] = {}
+        #: the range ``(lower, upper)`` of each joint coordinate (rad or m; ``None``: unbounded
+        #: that way); a mimic joint's is not the model's (:mod:`amble.modelling.limits`)
         self.limits: dict[str, tuple[float | None, float | None]] = {}
         #: the robot file the tree was read from (None when built in code), for drawing its meshes
         self.file: Any = None
@@ -256,7 +258,8 @@ class RigidTree:
                 (b.coordinate,) = m.coordinates([cname], unit=unit or ("m" if joint.type == "prismatic" else "rad"))
                 b.index = m.q.index(b.coordinate)
                 b.rate = m.dot(b.coordinate)
-                self.limits[cname] = (joint.lower, joint.upper)
+                # a continuous joint has no range whatever limits it is given (URDF ignores them too)
+                self.limits[cname] = (None, None) if joint.type == "continuous" else (joint.lower, joint.upper)
         self._kinematics(b)
         self.bodies.append(b)
         self._by_name[name] = b

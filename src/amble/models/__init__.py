@@ -203,7 +203,12 @@ def is_robot_file(spec: str) -> bool:
     return spec.lower().endswith(ROBOT_SUFFIXES + tuple(_UNREAD))
 
 
-def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: bool = False) -> HybridSystem:
+#: what a robot file's joint limits do in :func:`load_robot`: nothing, or end the run
+LIMIT_ACTIONS = ("ignore", "stop")
+
+
+def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: bool = False,
+               limits: str = "ignore") -> HybridSystem:
     """The robot of a URDF or MJCF file as a system of one mode. No ground, no contact: a
     floating robot falls, a fixed one swings under gravity; the default start is every coordinate
     and rate zero.
@@ -216,7 +221,11 @@ def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: boo
     An MJCF file (``.xml``, ``.mjcf``, read by MuJoCo's compiler): its bodies hang from the world
     as the file writes them, a body with a free joint floats (coordinates named after the joint),
     or is welded where the file places it with ``fixed_base``; zero is the file's pose. ``base``
-    is refused: the file's own tree is kept."""
+    is refused: the file's own tree is kept.
+
+    ``limits``: ``"ignore"`` (default) lets joints pass their limits as if they had none;
+    ``"stop"`` ends the run where a joint reaches one (:meth:`HybridSystem.stop_at_limits`:
+    status ``joint_limit``, the last event ``<coordinate>_<bound>_limit``)."""
     from ..modelling.hybrid import HybridSystem
     from ..modelling.model import Model
     from ..modelling.tree import Joint
@@ -242,6 +251,14 @@ def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: boo
         what = "fixed base" if fixed_base else "floating base"
     system = HybridSystem(model.name, model, doc=f"{Path(text).name}: {what}, {len(model.q)} coordinates")
     system.default_start[model.name] = [0.0] * (2 * len(model.q))
+    if limits not in LIMIT_ACTIONS:
+        raise ModelError(f"limits must be one of {', '.join(LIMIT_ACTIONS)}, got {limits!r}")
+    if limits == "stop":
+        import warnings
+
+        with warnings.catch_warnings():  # a robot without limits: the caller says so (the command line does)
+            warnings.simplefilter("ignore")
+            system.stop_at_limits()
     return system
 
 
