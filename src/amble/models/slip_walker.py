@@ -67,7 +67,7 @@ from amble import POSITIVE, Explicit, Guard, Model, Walker, interval
 NAME = "slip-walker"
 POSITION = 72  # place in `amble models` (ascending)
 
-PARAMS = dict(m=80.0, L0=1.0, k=20000.0, alpha=math.radians(69.0), g=9.81, energy=820.0)
+PARAMS = dict(m=80.0, L0=1.0, k=20000.0, alpha=math.radians(69.0), g=9.81, energy=840.0)
 
 
 def _params(model: Model) -> tuple:
@@ -130,6 +130,10 @@ def build(snap_to_energy: bool = True) -> Walker:
     s.terminal("front_leg_unloads", "double", Guard(k * (L0 - front), -1), status="fell")
     s.terminal("falls_back", "single", Guard(ud, -1), status="fell")
     s.terminal("falls_back_in_double_support", "double", Guard(dud, -1), status="fell")
-    s.default_start["single"] = [0.0, 0.98, 1.1, 0.0]
-    s.fixed_point_guess = [0.0, 0.98, 1.1, 0.0]
+    # midstance 0.98 m high, level, on the default energy level (off the gait: the run settles)
+    p = PARAMS
+    w0 = 0.98
+    u0 = math.sqrt(2 * (p["energy"] - p["m"] * p["g"] * w0 - p["k"] * (p["L0"] - w0) ** 2 / 2) / p["m"])
+    s.default_start["single"] = [0.0, w0, u0, 0.0]
+    s.fixed_point_guess = [0.0, 0.99, 1.24, 0.0]
     return s
