@@ -22,10 +22,8 @@ A step is a directed cycle of two domains, single and double support::
   The legs are massless, so nothing is lost: positions and velocities are unchanged.
 * **double** (double support): ``u, w`` (m), the mass relative to the rear foot (the origin), and
   ``d`` (m), the front foot's distance ahead of the rear foot. Both springs push on the mass. The
-  front foot does not move: ``d`` is a coordinate only so that the domain carries where the foot
-  landed. Its velocity starts at zero and stays zero because the ground's friction on the foot,
-  the generalized force ``∂V/∂d``, balances the spring's push on it exactly (``d_dot`` carries
-  no energy: the kinetic term ``m d_dot² / 2`` is zero along every run).
+  front foot does not move: ``d`` is a held coordinate (``Model.hold``), set at touchdown with
+  ``d_dot = 0`` and constant through the phase (its equation is ``d_ddot = 0``).
 * **liftoff** (double → single): the rear spring's force ``k (L0 − l_rear)`` falls through zero,
   the rear leg back at its rest length; the front foot becomes the origin (``u → u − d``).
 * **midstance** (single → single, the step of the return map): the vertical leg orientation,
@@ -79,7 +77,7 @@ def _params(model: Model) -> tuple:
 
 def _single() -> Model:
     s = Model("single")
-    u, w = s.coordinates("u w")
+    u, w = s.coordinates("u w", unit="m")
     m, L0, k, alpha, g, _ = _params(s)
     s.point("foot", (0, 0))
     s.point("mass", (u, w), mass=m, link="foot")
@@ -91,7 +89,7 @@ def _single() -> Model:
 
 def _double() -> Model:
     dm = Model("double")
-    u, w, d = dm.coordinates("u w d")
+    u, w, d = dm.coordinates("u w d", unit="m")
     m, L0, k, _, g, _ = _params(dm)
     dm.point("foot", (0, 0))
     dm.point("mass", (u, w), mass=m, link="foot")
@@ -99,10 +97,8 @@ def _double() -> Model:
     dm.gravity(g)
     front = k * (L0 - sp.sqrt((u - d) ** 2 + w**2)) ** 2 / 2
     dm.add_potential(k * (L0 - sp.sqrt(u**2 + w**2)) ** 2 / 2 + front)
-    # d_dot carries no energy (it stays zero); its kinetic term only makes d a coordinate
-    dm.add_kinetic(m * dm.qd[2] ** 2 / 2)
-    # the ground holds the front foot: its friction balances the spring's push along d exactly
-    dm.force([0, 0, sp.diff(front, d)])
+    # where the front foot landed: the ground holds it there for the whole phase
+    dm.hold(d)
     return dm
 
 
