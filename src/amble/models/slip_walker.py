@@ -40,7 +40,7 @@ section is the vertical leg orientation, ``(0, w, u_dot(w, w_dot), w_dot)``: its
 coordinates are the height ``w`` and the vertical velocity ``w_dot`` of the mass when it passes
 over the stance foot. A symmetric walking gait has ``w_dot = 0`` there.
 
-Parameters (Geyer et al. 2006: 80 kg, 1 m legs, 20 kN/m, walking at a system energy of 820 J):
+Parameters (Geyer et al. 2006's leg: 80 kg, 1 m, 20 kN/m; their walking energies are near 820 J):
 
 ==========  ==========  =====  =============================================================
 name        default     unit   meaning
@@ -50,8 +50,14 @@ name        default     unit   meaning
 ``k``       20000       N/m    leg stiffness (both legs)
 ``alpha``   69° = 1.204 rad    angle of attack from the horizontal, swing foot ahead of the mass
 ``g``       9.81        m/s²   gravity
-``energy``  820         J      system energy, ``m g w + m v² / 2`` plus the springs' energy
+``energy``  840         J      system energy, ``m g w + m v² / 2`` plus the springs' energy
 ==========  ==========  =====  =============================================================
+
+At the defaults the walking gait passes midstance 0.990359 m high at 1.24335 m/s, steps 0.5456 m
+in 0.41654 s (1.31 m/s on average), with a double support of 0.12214 s, and is stable: a complex
+pair of multipliers 0.2621 ± 0.9179i (modulus 0.955). At 820 J the same leg and angle walk on a
+symmetric gait that is just unstable (modulus 1.160); it becomes stable at 834.9 J. At 820 J a
+softer leg walks stably (15 kN/m at 69°–72°: modulus 0.97 to 0.85).
 """
 
 from __future__ import annotations
