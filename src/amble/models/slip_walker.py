@@ -57,7 +57,7 @@ At the defaults the walking gait passes midstance 0.990359 m high at 1.24335 m/s
 in 0.41654 s (1.31 m/s on average), with a double support of 0.12214 s, and is stable: a complex
 pair of multipliers 0.2621 ± 0.9179i (modulus 0.955). At 820 J the same leg and angle walk on a
 symmetric gait that is just unstable (modulus 1.160); it becomes stable at 834.9 J. At 820 J a
-softer leg walks stably (15 kN/m at 69°–72°: modulus 0.97 to 0.85).
+softer leg walks stably (15 kN/m at 69°–72°: modulus between 0.85 and 0.97).
 """
 
 from __future__ import annotations
