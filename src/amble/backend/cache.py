@@ -170,6 +170,8 @@ def _structure_digest(system: HybridSystem) -> str:
         parts += [[vc.outputs, vc.phase, vc.alpha] if vc is not None else []]
         if m.holonomic_constraints:  # absent from an unconstrained mode: its parts are as they were
             parts += [[(k, v, m.baumgarte.get(k)) for k, v in m.holonomic_constraints.items()]]
+        if m.held:  # likewise absent where nothing is held
+            parts += [["held", m.held]]
         h.update(dag_srepr(parts).encode())
     for tr in system.transitions:
         h.update(repr((tr.name, tr.source, tr.target, tr.terminal, tr.step)).encode())

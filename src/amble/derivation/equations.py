@@ -239,7 +239,9 @@ def derive(model: Model, control: bool = True) -> Equations:
         defs = model.tree.defs
         compact = (defs.needed([*Mt, *ht]), M + Mt, h + ht)
         M, h = M + defs.expand(Mt), h + defs.expand(ht)
-    B = model.input_matrix()
+    B, Gamma = model.input_matrix(), model.generalized_force
+    if model.held:
+        M, h, Gamma, B, compact = _hold(model, M, h, Gamma, B, compact)
     u = model.control_law
     if model.derived_placeholders and u.rows:
         subs = {s: (M if kind == "M" else h)[i, j] for s, (kind, i, j) in model.derived_placeholders.items()}
@@ -252,8 +254,39 @@ def derive(model: Model, control: bool = True) -> Equations:
             u = sp.Matrix([e if a.limit is None else sp.Max(-a.limit, sp.Min(a.limit, e))
                            for e, a in zip(u, model.actuators)])
         compact = ([*defs, *hdefs], Mc, hc)
-    return Equations(model=model, M=M, h=h, Gamma=model.generalized_force, K=K, V=V, energy=energy,
+    return Equations(model=model, M=M, h=h, Gamma=Gamma, K=K, V=V, energy=energy,
                      compact=compact, B=B, inputs=model.inputs, u=u, holonomic=holonomic_terms(model))
+
+
+def _hold(model: Model, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, B: sp.Matrix, compact: Any
+          ) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix, sp.Matrix, Any]:
+    """The equations with each held coordinate's row replaced by ``q̈ᵢ = 0`` (``Model.hold``).
+
+    Its column of ``M`` multiplies ``q̈ᵢ = 0`` in the other rows and is cleared with the row, so
+    ``M`` stays symmetric (the compiled code factors it as such); its terms in ``h`` of the other
+    rows are those of a constant with zero velocity."""
+    if model.virtual is not None:
+        raise ModelError(f"model {model.name!r}: held coordinates and virtual constraints cannot be combined")
+    idx = [model.q.index(qi) for qi in model.held]
+
+    def held(Mx: sp.Matrix, hx: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
+        Mx, hx = Mx.copy(), hx.copy()
+        for i in idx:
+            Mx[i, :] = sp.zeros(1, Mx.cols)
+            Mx[:, i] = sp.zeros(Mx.rows, 1)
+            Mx[i, i] = sp.Integer(1)
+            hx[i] = sp.Integer(0)
+        return Mx, hx
+
+    M, h = held(M, h)
+    Gamma, B = Gamma.copy(), B.copy()
+    for i in idx:
+        Gamma[i] = sp.Integer(0)
+        if B.cols:
+            B[i, :] = sp.zeros(1, B.cols)
+    if compact is not None:
+        compact = (compact[0], *held(compact[1], compact[2]))
+    return M, h, Gamma, B, compact
 
 
 def _add_point_masses(model: Model, M: sp.Matrix, h: sp.Matrix) -> None:

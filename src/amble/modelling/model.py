@@ -80,6 +80,8 @@ class Model(Actuators):
         #: Baumgarte gains (α, β) of each set (1/time units; (0, 0): none)
         self.holonomic_constraints: dict[str, list[sp.Expr]] = {}
         self.baumgarte: dict[str, tuple[float, float]] = {}
+        #: coordinates held constant in this mode (:meth:`hold`), in declaration order
+        self.held: list[sp.Symbol] = []
 
     def dt(self, expr: Any) -> Any:
         """Total time derivative of an expression (or vector) of q and t, by the chain rule
@@ -255,6 +257,26 @@ class Model(Actuators):
     def add_potential(self, expr: Any) -> None:
         """Add a potential-energy term (J) in q, e.g. a spring ``k*(q1 - q2)**2/2``."""
         self._v_terms.append(_expr(self, expr, "potential energy term"))
+
+    @declaration
+    def hold(self, *coordinates: Any) -> None:
+        """Hold coordinates constant in this mode: their equations of motion become ``q̈ᵢ = 0``.
+
+        A held coordinate is a value that a domain carries from the state it was entered in, such
+        as where a foot landed: the reset into the mode sets it, with its velocity zero, and it
+        stays there (its velocity keeps the value the reset gives it). The other coordinates'
+        equations see it as a constant: no mass, force or input acts along it, and the mass
+        matrix has a unit row and column there. Energies may depend on it (a spring to the held
+        foot); with its velocity zero it carries no kinetic energy, so a conservative mode stays
+        conservative. ``coordinates``: symbols of this model's coordinates or their names.
+        """
+        for c in coordinates:
+            name = str(c)
+            match = [qi for qi in self.q if str(qi) == name]
+            if not match:
+                raise ModelError(f"model {self.name!r}: cannot hold {name!r}: it is not a coordinate")
+            if match[0] not in self.held:
+                self.held.append(match[0])
 
     @property
     def K(self) -> sp.Expr:
@@ -449,6 +471,7 @@ class Model(Actuators):
         self._copy_actuators(out, subs, vsubs)
         out.holonomic_constraints = {k: [put(e) for e in v] for k, v in self.holonomic_constraints.items()}
         out.baumgarte = dict(self.baumgarte)
+        out.held = [qi for qi in self.held if qi in out.q]
         return out
 
     # ------------------------------------------------------------------ helpers
