@@ -61,7 +61,7 @@ PARAMS = dict(m=10.0, L=0.5, k=4000.0, c=80.0, delta=0.05, g=9.81)
 def _domain(name: str, rest: sp.Expr | None) -> Model:
     """A domain in ``y``; ``rest``: the spring's rest length in stance (None: flight)."""
     d = Model(name)
-    (y,) = d.coordinates("y")
+    (y,) = d.coordinates("y", unit="m")
     (yd,) = d.qd
     m, L, k, c, delta, g = d.parameters(**PARAMS)
     d.restrict("m L k g", POSITIVE)

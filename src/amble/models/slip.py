@@ -81,7 +81,7 @@ def _params(model: Model) -> tuple:
 
 def _flight(name: str) -> Model:
     fl = Model(name)
-    x, y = fl.coordinates("x y")
+    x, y = fl.coordinates("x y", unit="m")
     m, L0, _, alpha, g, *_ = _params(fl)
     fl.point("ground", (x, 0))
     fl.point("mass", (x, y), mass=m)
@@ -99,7 +99,7 @@ def build(snap_to_energy: bool = True) -> HybridSystem:
     m, L0, k, alpha, g, y0, v0 = (down.symbol(n) for n in PARAMS)
 
     st = Model("stance")
-    u, w = st.coordinates("u w")
+    u, w = st.coordinates("u w", unit="m")
     _params(st)
     st.point("foot", (0, 0))
     st.point("mass", (u, w), mass=m, link="foot")

@@ -94,7 +94,7 @@ def _leg(L0: sp.Expr, alpha: sp.Expr, beta: sp.Expr) -> sp.Matrix:
 
 def _flight(name: str) -> Model:
     fl = Model(name, dims=3)
-    x, y, z = fl.coordinates("x y z")
+    x, y, z = fl.coordinates("x y z", unit="m")
     m, L0, _, alpha, beta, g, *_ = _params(fl)
     mass = sp.Matrix([x, y, z])
     fl.point("ground", (x, y, 0))
@@ -113,7 +113,7 @@ def build(snap_to_energy: bool = True) -> Walker:
     m, L0, k, alpha, beta, g, z0, v0 = (down.symbol(n) for n in PARAMS)
 
     st = Model("stance", dims=3)
-    u, v, w = st.coordinates("u v w")
+    u, v, w = st.coordinates("u v w", unit="m")
     _params(st)
     st.point("foot", (0, 0, 0))
     st.point("mass", (u, v, w), mass=m, link="foot")
