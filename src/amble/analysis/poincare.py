@@ -24,7 +24,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..backend.kernels import Kernels, compiled
+from ..backend.kernels import compiled
+from ..backend.library import Kernels
 from ..errors import ConvergenceError, ModelError, SimulationError, StateError
 from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import initial_state, parameter_vector, simulate
