@@ -33,7 +33,7 @@ _WHERE: dict[str, str] = {
     "sample_and_hold": ".modelling.sampled",
     "parse": ".modelling.text",
     **dict.fromkeys(("base_relabel", "stance_feet_walker"), ".modelling.stance_feet"),
-    "Joint": ".modelling.tree",
+    "Joint": ".modelling.bodies",
     **dict.fromkeys(("Walker", "joint_lock", "walker"), ".modelling.walker"),
     **dict.fromkeys(("Options", "run", "walk_many"), ".simulation.engine"),
     "parameter_vector": ".simulation.simulate",
@@ -112,6 +112,7 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
         SimulationError,
         StateError,
     )
+    from .modelling.bodies import Joint  # noqa: F401
     from .modelling.contact import (  # noqa: F401
         RoundFoot,
         compliant_contact,
@@ -128,7 +129,6 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
     from .modelling.model import Model  # noqa: F401
     from .modelling.sampled import sample_and_hold  # noqa: F401
     from .modelling.stance_feet import base_relabel, stance_feet_walker  # noqa: F401
-    from .modelling.tree import Joint  # noqa: F401
     from .modelling.walker import Walker, joint_lock, walker  # noqa: F401
     from .simulation.engine import Options  # noqa: F401
     from .simulation.simulate import simulate  # noqa: F401
