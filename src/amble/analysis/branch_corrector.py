@@ -45,7 +45,7 @@ class _Problem:
 
     def __init__(self, system: HybridSystem, params: Mapping[str, float] | None, param: str, period: int,
                  rtol: float, atol: float) -> None:
-        from .poincare import ReturnMap
+        from .return_map import ReturnMap
 
         self.P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
         names = list(self.P.k.meta["params"])
