@@ -33,7 +33,7 @@ _WHERE: dict[str, str] = {
     "sample_and_hold": ".modelling.sampled",
     "parse": ".modelling.text",
     **dict.fromkeys(("base_relabel", "stance_feet_walker"), ".modelling.stance_feet"),
-    "Joint": ".modelling.tree",
+    "Joint": ".modelling.bodies",
     **dict.fromkeys(("Walker", "joint_lock", "walker"), ".modelling.walker"),
     **dict.fromkeys(("Options", "run", "walk_many"), ".simulation.engine"),
     "parameter_vector": ".simulation.simulate",
@@ -48,7 +48,8 @@ _WHERE: dict[str, str] = {
     "bifurcations": ".analysis.branch_bifurcations",
     **dict.fromkeys(("sweep_fixed_points", "sweep_fixed_points_2d"), ".analysis.fixed_points"),
     **dict.fromkeys(("bifurcation", "poincare_iterates"), ".analysis.bifurcation"),
-    **dict.fromkeys(("cascade", "continue_branch", "locate_bifurcation", "switch_at_flip"), ".analysis.continuation"),
+    **dict.fromkeys(("cascade", "continue_branch", "switch_at_flip"), ".analysis.continuation"),
+    "locate_bifurcation": ".analysis.bifurcation_location",
     "basin": ".analysis.basin",
     "find_gaits": ".analysis.gaits",
     "period_doublings": ".analysis.doublings",
@@ -58,7 +59,9 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("MarkovPassage", "markov_mfpt"), ".analysis.markov"),
     **dict.fromkeys(("GaitSensitivity", "gait_sensitivity"), ".analysis.robustness"),
     **dict.fromkeys(("BasinMeasures", "basin_measures"), ".analysis.basin_measures"),
-    **dict.fromkeys(("MujocoReplay", "planar_biped_mjcf", "replay_in_mujoco"), ".analysis.mujoco_replay"),
+    "MujocoReplay": ".analysis.mujoco_drift",
+    "planar_biped_mjcf": ".analysis.mujoco_biped",
+    "replay_in_mujoco": ".analysis.mujoco_replay",
     "gait_gradients": ".analysis.gait_gradients",
     "check_gait": ".analysis.gait_check",
     "simulate": ".simulation.simulate",
@@ -111,6 +114,7 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
         SimulationError,
         StateError,
     )
+    from .modelling.bodies import Joint  # noqa: F401
     from .modelling.contact import (  # noqa: F401
         RoundFoot,
         compliant_contact,
@@ -127,7 +131,6 @@ if TYPE_CHECKING:  # what static tools (type checkers, import graphs) see
     from .modelling.model import Model  # noqa: F401
     from .modelling.sampled import sample_and_hold  # noqa: F401
     from .modelling.stance_feet import base_relabel, stance_feet_walker  # noqa: F401
-    from .modelling.tree import Joint  # noqa: F401
     from .modelling.walker import Walker, joint_lock, walker  # noqa: F401
     from .simulation.engine import Options  # noqa: F401
     from .simulation.simulate import simulate  # noqa: F401

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from amble.analysis.bifurcation import poincare_iterates
-from amble.analysis.continuation import _tests, cascade, continue_branch
+from amble.analysis.bifurcation_location import _tests
+from amble.analysis.continuation import cascade, continue_branch
 from amble.analysis.poincare import ReturnMap, find_fixed_point
 from amble.analysis.section import Section
 from amble.cli.main import main

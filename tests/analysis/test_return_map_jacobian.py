@@ -7,7 +7,7 @@ section's chart. Their error is O(h⁴) + tol/h, about 1e-7 with the map's toler
 import numpy as np
 import pytest
 
-from amble.analysis import poincare
+from amble.analysis import return_map
 from amble.analysis.poincare import ReturnMap, find_fixed_point
 from amble.analysis.section import Section, chart
 from amble.backend.variational_codegen import OPTIMISE_LIMIT, _unoptimised
@@ -62,13 +62,13 @@ def test_the_exact_jacobian_is_one_run(gait, monkeypatch):
     system, lc = gait
     P = ReturnMap(system, lc.parameters)
     calls = []
-    real = poincare.run
+    real = return_map.run
 
     def counted(*a, **kw):
         calls.append(kw.get("sensitivities", False))
         return real(*a, **kw)
 
-    monkeypatch.setattr(poincare, "run", counted)
+    monkeypatch.setattr(return_map, "run", counted)
     P.section_jacobian(lc.fixed_point)
     P.section_jacobian(lc.fixed_point)
     assert calls == ["state", "state"]  # one run each, without parameter columns

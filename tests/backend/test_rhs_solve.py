@@ -6,7 +6,7 @@ import pytest
 from chains import pendulum_chain
 
 from amble import HybridSystem, Model
-from amble.backend import codegen
+from amble.backend import ldl
 from amble.backend.kernels import compiled
 from amble.models import load
 
@@ -31,7 +31,7 @@ def test_unrolled_solve_matches_lapack(model):
 
 
 def test_loop_solve_matches_lapack():
-    n = codegen.UNROLL_MAX + 2  # past the unrolled size: amble_ldl_solve in amble_core.h
+    n = ldl.UNROLL_MAX + 2  # past the unrolled size: amble_ldl_solve in amble_core.h
     m = pendulum_chain(n, f"solve_chain{n}")
     k = compiled(HybridSystem(m.name, m))
     assert "amble_ldl_solve(" in k.path.with_suffix(".c").read_text()
@@ -39,11 +39,11 @@ def test_loop_solve_matches_lapack():
 
 
 def test_unrolled_code_has_no_square_root():
-    src = codegen.ldl_solve_code(4, "M", "f")
+    src = ldl.ldl_solve_code(4, "M", "f")
     assert "sqrt" not in src and "for" not in src
 
 
-@pytest.mark.parametrize("n", [2, codegen.UNROLL_MAX + 1])
+@pytest.mark.parametrize("n", [2, ldl.UNROLL_MAX + 1])
 def test_singular_mass_matrix_is_refused(n):
     # a chain whose last two links have no inertia of their own: M is singular everywhere
     m = Model(f"singular{n}")
@@ -82,10 +82,10 @@ def test_sparse_reordered_solve_matches_lapack(tmp_path):
     n = 7
     nonzero = {(i, j) for i in range(n) for j in range(i)} - {(1, 0), (5, 2), (5, 3), (5, 4), (6, 2), (6, 3),
                                                              (6, 4), (6, 5)}
-    order = codegen.ldl_order(n, nonzero)
+    order = ldl.ldl_order(n, nonzero)
     assert order[:2] == [5, 6]
-    code = codegen.ldl_solve_code(n, "M", "f", order=order, nonzero=nonzero)
-    assert code.count("*") < codegen.ldl_solve_code(n, "M", "f").count("*")
+    code = ldl.ldl_solve_code(n, "M", "f", order=order, nonzero=nonzero)
+    assert code.count("*") < ldl.ldl_solve_code(n, "M", "f").count("*")
     solve = _compiled_solve(n, code, tmp_path)
     zeros = {(i, j) for i in range(n) for j in range(i)} - nonzero
     rng = np.random.default_rng(3)

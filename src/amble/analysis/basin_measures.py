@@ -45,7 +45,8 @@ from ..backend.abi import CODE
 from ..errors import ConvergenceError, StateError
 from ..simulation.engine import Options, walk_many
 from .defaults import BASIN_STEPS, BASIN_TOL
-from .poincare import LimitCycle, ReturnMap
+from .limit_cycle import LimitCycle
+from .return_map import ReturnMap
 from .section import Section
 
 #: how a walk counts as inside the basin

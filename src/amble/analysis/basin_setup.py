@@ -57,7 +57,8 @@ def setup(system: HybridSystem, params: Mapping[str, float] | None, pvec: np.nda
     post-impact section through its image (integrator tolerances ``rtol``, ``atol``) charted by the
     coordinates ``x_names`` first (of the state names ``snames``): :class:`StateError` when the
     two are tied on it. Each from the table when the same inputs were seen before."""
-    from .poincare import ReturnMap, find_fixed_point
+    from .poincare import find_fixed_point
+    from .return_map import ReturnMap
 
     k = compiled(system, derivatives=True)
     owners, base = (system, k), (id(system), id(k), np.asarray(pvec, float).tobytes(), _system_key(system))

@@ -39,7 +39,7 @@ def _onto_section(system: HybridSystem, params: Mapping[str, float], x: np.ndarr
     """A state carried from the previous parameter value, put on the section of ``params`` with
     its section coordinates kept (:meth:`Section.project`); unchanged when no footfall from it can
     be found (the transient then reports why)."""
-    from .poincare import ReturnMap
+    from .return_map import ReturnMap
 
     try:
         return Section.of(ReturnMap(system, params, rtol=rtol, atol=atol), x).project(x)

@@ -6,7 +6,7 @@ codimension-one bifurcation is crossed (:mod:`amble.analysis.multipliers`): ψ_f
 through +1), ψ_flip (a real μ through −1) and ψ_torus (a complex pair through |μ| = 1). For a
 fixed-point branch they are evaluated from each row's stored multipliers; between two
 neighbouring converged gaits of one branch where one changes sign, the bifurcation is located on
-the branch by :func:`~amble.analysis.continuation.locate_bifurcation` (secant with bisection,
+the branch by :func:`~amble.analysis.bifurcation_location.locate_bifurcation` (secant with bisection,
 each iterate corrected onto the branch, to 1e-12 in the parameter) when the system is given.
 A continuation locates them as it traces its branches; its result holds them as rows.
 
@@ -22,7 +22,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import StateError
-from .continuation import BifurcationPoint, BranchPoint, locate_bifurcation
+from .bifurcation_location import locate_bifurcation
+from .branch import BifurcationPoint, BranchPoint
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .multipliers import KINDS, torus_pair
 from .store import SweepResult, state_from_row
@@ -152,7 +153,7 @@ def bifurcations(result: SweepResult, system: HybridSystem | None = None, *,
       bracketing grid point with the smaller |ψ| stands for it (``located=False``);
     - a continuation: the bifurcations located as its branches were traced (branch by branch).
 
-    Each is a :class:`~amble.analysis.continuation.BifurcationPoint`: ``kind`` (``"fold"``,
+    Each is a :class:`~amble.analysis.branch.BifurcationPoint`: ``kind`` (``"fold"``,
     ``"flip"``, ``"torus"``), ``value``, the gait and multipliers there (``point``),
     ``direction`` (stability before → after, in grid order), and for a torus point ``angle``
     θ = |arg μ| (rad), ``rotation`` θ/2π and ``resonance`` (a strong resonance 1:1, 1:2, 1:3,

@@ -24,7 +24,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import AmbleError, OutputError, StateError
-from .continuation import Branch, BranchPoint, cascade
+from .branch import Branch, BranchPoint
+from .continuation import cascade
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .multipliers import KINDS, resonance, torus_pair
 from .runner import sweep_values

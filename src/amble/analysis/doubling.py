@@ -1,7 +1,7 @@
 """Where the period-1 gait period-doubles, read from any sweep's result: one detector.
 
 A period doubling (a flip) is where a real Floquet multiplier of the period-1 gait crosses −1.
-It is *located* in one place, :func:`amble.analysis.continuation.locate_flip`: the zero of
+It is *located* in one place, :func:`amble.analysis.bifurcation_location.locate_flip`: the zero of
 ``ψ_flip = det(A + I)`` between two gaits of the branch, by the secant method with bisection,
 each iterate corrected onto the branch. Continuation locates the flips it passes with it while it
 traces a branch; :func:`period_doubling` finds the bracketing pair in the rows of a fixed-point
@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
 from ..errors import StateError
-from .continuation import locate_flip
+from .bifurcation_location import locate_flip
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .store import SweepResult, state_from_row
 
@@ -91,7 +91,7 @@ def period_doubling(result: SweepResult, system: HybridSystem | None = None, *,
 
     - a fixed-point branch (``amble.sweep(system, "fixed-point", {param: values})``): between the
       first two neighbouring converged points whose lowest real multiplier lies on either side of
-      −1, the flip is located on the branch (:func:`~amble.analysis.continuation.locate_flip`:
+      −1, the flip is located on the branch (:func:`~amble.analysis.bifurcation_location.locate_flip`:
       the multiplier there is −1 to about 1e-8) when the ``system`` is given, with ``params`` the
       sweep's other parameters; without it, the multiplier is interpolated linearly between the
       two points (an estimate, off by the grid's curvature);

@@ -32,7 +32,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import AmbleError, StateError
-from .continuation import BifurcationPoint, Branch, continue_branch, switch_at_flip
+from .branch import BifurcationPoint, Branch
+from .continuation import continue_branch, switch_at_flip
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy

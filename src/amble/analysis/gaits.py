@@ -55,7 +55,9 @@ import numpy as np
 from ..errors import AmbleError, ConvergenceError, SimulationError, StateError
 from ..simulation.simulate import initial_state
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
-from .poincare import MAX_PERIOD, LimitCycle, ReturnMap, default_guess, find_fixed_point
+from .limit_cycle import LimitCycle
+from .poincare import default_guess, find_fixed_point
+from .return_map import MAX_PERIOD, ReturnMap
 from .section import Section
 
 if TYPE_CHECKING:  # a compiled system (amble.backend.compiled) serves too, without SymPy

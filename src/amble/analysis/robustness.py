@@ -9,7 +9,7 @@ only: the step from the gait's post-impact state ``x*`` runs with ``p + δ e``, 
     ``Δx₁ = (∂P/∂p) e δ``,   ``Δxₖ₊₁ = (∂P/∂x) Δxₖ``,
 
 and the step times by ``ΔT₀ = (∂T/∂p) e δ``, ``ΔTₖ = (∂T/∂x) Δxₖ`` (k ≥ 1), with the return
-map's exact derivatives at the gait (:meth:`amble.analysis.poincare.ReturnMap.derivatives`). The
+map's exact derivatives at the gait (:meth:`amble.analysis.return_map.ReturnMap.derivatives`). The
 gait sensitivity norm of an indicator ``g`` is the 2-norm of its response per unit disturbance,
 ``sqrt(Σₖ (Δgₖ/δ)²)``: here the step time (s per unit of the parameter) and every post-impact state
 coordinate, and ``state``, the norm over all of them. The sum is taken until the response has
@@ -25,7 +25,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConvergenceError, StateError
-from .poincare import LimitCycle, ReturnMap
+from .limit_cycle import LimitCycle
+from .return_map import ReturnMap
 
 #: steps summed at most
 MAX_STEPS = 100_000

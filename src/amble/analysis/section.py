@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from ..backend.kernels import Kernels
+from ..backend.library import Kernels
 from ..errors import ConvergenceError, ModelError, StateError
 
 #: Relative singular-value threshold below which a tangent direction of the section is dropped.

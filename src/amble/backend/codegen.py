@@ -13,122 +13,22 @@ that the right-hand side is inlined into the integrator.
 
 from __future__ import annotations
 
-from dataclasses import replace
-from typing import Any
-
 import sympy as sp
-from sympy.core.relational import Relational
 
 from ..derivation.equations import derive
-from ..derivation.holonomic import Holonomic
-from ..derivation.impact import impulse_data
 from ..derivation.switching import switching_surfaces
-from ..modelling.hybrid import HybridSystem, target_exprs
+from ..modelling.hybrid import HybridSystem
 from ..modelling.model import t
 from . import abi
-from .codegen_support import ModeInfo, count_ops
-from .codegen_support import Printer as _Printer
+from .codegen_support import ModeInfo
 from .codegen_support import block as _block
-from .codegen_support import bool_expr as _bool_block
 from .codegen_support import symbol_names as _names
+from .dynamics_codegen import _defs_code, _dynamics_code
 from .hoist import Hoister
-from .ldl import UNROLL_MAX, constant_pivots, ldl_order, ldl_solve_code
 from .runtime import CAPACITY_MACRO, TAIL, capacity
-from .trig import pythagoras
-from .units import UNIT_BEGIN, UNIT_END
+from .transition_codegen import _enabled_code, _reset_code
 from .variational_codegen import derivative_kernels, derivative_stubs
 
-
-def _dynamics_code(k: int, n: int, M: sp.Matrix, h: sp.Matrix, Gamma: sp.Matrix, nm: dict[sp.Symbol, str],
-                   prelude: str, hoist: Hoister, prelude_ops: int = 0, hol: Holonomic | None = None,
-                   shared: bool = False) -> str:
-    """``mh_k`` (the lower triangle of M, h and Γ — emitted once: for a large tree it is most of
-    the unit and of the compile time), and the two kernels that use it: ``rhs_k`` (q̈ = M⁻¹ (Γ − h)
-    by an LDLᵀ solve) and ``dynamics_k`` (full M, h, Γ for analysis and display). Parameter-only
-    subexpressions are read from the prelude (``hoist``), and so are the pivots and multipliers of
-    a leading block of M that depends on parameters only (the compass gait's M₀₀). A mode with
-    holonomic constraints (``hol``) solves its KKT system instead (:func:`_holonomic_code`)."""
-    tg = [f"M[{i * n + j}]" for i in range(n) for j in range(i + 1)] + [f"h[{i}]" for i in range(n)]
-    tg += [f"G[{i}]" for i in range(n)]
-    ex = [M[i, j] for i in range(n) for j in range(i + 1)] + list(h) + list(Gamma)
-    ex = pythagoras(ex)  # a·sin²u + a·cos²u = a: Lagrangian mass matrices are full of it
-    # common factors out of sums, m·l·(cos a cos b + sin a sin b) instead of m·(l cos a cos b + l sin a
-    # sin b): the parameter part becomes one hoisted value (compass gait: −2 % instructions per walk);
-    # small models only, where M and h are inlined into the right-hand side and factoring is cheap
-    if count_ops(ex) <= INLINE_OPS:
-        ex = [sp.factor_terms(e) for e in ex]
-    low = lambda i, j: ex[max(i, j) * (max(i, j) + 1) // 2 + min(i, j)]  # M[i, j] of the lower triangle
-    nonzero = {(i, j) for i in range(n) for j in range(i) if low(i, j) != 0}
-    if not hoist.enabled:  # the code of before (benchmarks): a dense solve in the natural order
-        nonzero = {(i, j) for i in range(n) for j in range(i)}
-    order = ldl_order(n, nonzero) if n <= UNROLL_MAX else list(range(n))
-    known = constant_pivots(sp.Matrix(n, n, lambda i, j: low(order[i], order[j])), nm, hoist)
-    ex = hoist(ex)
-    # small kernels are inlined into both callers (a call costs as much as their body); large ones
-    # are compiled once, in a unit of their own compiled beside the rest (units.split_units). A
-    # tree's M and h are names (its size is in the prelude): inlined into rhs_k, its q̈ is faster
-    # (the humanoid's 10.8 µs against 14.3 µs out of line), so rhs_k keeps an inlined copy and
-    # dynamics_k calls one in its own unit (both copies in one unit: 22 s of gcc instead of 11)
-    ops = count_ops(ex)
-    sig = "(double t, const double *x, const double *p, double *M, double *h, double *G)"
-    body = "    (void)t; (void)x; (void)p;\n" + _block(tg, ex, {**nm, **hoist.names}, prelude=prelude) + "}\n"
-    inlined, own = f"static AMBLE_INLINE void mh_{k}{sig} {{\n" + body, f"AMBLE_HIDDEN void mh_{k}_out{sig} {{\n" + body
-    if prelude_ops + ops <= INLINE_OPS:
-        out, dyn = [inlined], f"mh_{k}"
-    elif ops <= INLINE_OPS:
-        out, dyn = [inlined, UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
-    else:
-        out, dyn = [UNIT_BEGIN, own, UNIT_END], f"mh_{k}_out"
-    rhs_mh = f"mh_{k}" if out[0] is inlined else dyn
-    if hol is not None:
-        out.append(_holonomic_code(k, n, rhs_mh, hol, nm, hoist, shared))
-    else:
-        out += [f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
-                f"    double M[{n * n}], h[{n}], f[{n}];\n",
-                f"    {rhs_mh}(t, x, p, M, h, f);\n",
-                f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
-                ldl_solve_code(n, "M", "f", known=known, order=order, nonzero=nonzero),
-                f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
-                "    return 0;\n}\n",
-                f"static int constraint_forces_{k}(double t, const double *x, const double *p, double *lam) {{\n",
-                "    (void)t; (void)x; (void)p; (void)lam;\n    return 0;\n}\n"]
-    out += [f"static void dynamics_{k}{sig} {{\n",
-            f"    {dyn}(t, x, p, M, h, G);\n",
-            f"    for (int i = 0; i < {n}; ++i)\n",
-            f"        for (int j = 0; j < i; ++j) M[j * {n} + i] = M[i * {n} + j];\n",
-            "}\n"]
-    return "".join(out)
-
-
-def _holonomic_code(k: int, n: int, mh: str, hol: Holonomic, nm: dict[sp.Symbol, str], hoist: Hoister,
-                    shared: bool) -> str:
-    """``accel_k`` (q̈ and λ of ``M q̈ = Γ − h + Jᵀλ``, ``J q̈ = γ``, by ``amble_holonomic_solve``:
-    the Cholesky factor of M, then the m × m system of λ), and the two kernels that use it:
-    ``rhs_k`` and ``constraint_forces_k`` (λ, :mod:`amble.derivation.holonomic`)."""
-    m = hol.J.rows
-    tg = [f"J[{a * n + b}]" for a in range(m) for b in range(n)] + [f"gam[{a}]" for a in range(m)]
-    ex = [hol.J[a, b] for a in range(m) for b in range(n)] + list(hol.gamma)
-    body = _block(tg, hoist(ex), {**nm, **hoist.names}, shared=shared)
-    return "".join([
-        f"static int accel_{k}(double t, const double *x, const double *p, double *f, double *lam) {{\n",
-        f"    double M[{n * n}], h[{n}], J[{m * n}], gam[{m}];\n",
-        f"    {mh}(t, x, p, M, h, f);\n",
-        f"    for (int i = 0; i < {n}; ++i) f[i] -= h[i];\n",
-        body,
-        f"    return amble_holonomic_solve({n}, {m}, M, J, gam, f, lam);\n}}\n",
-        f"static int rhs_{k}(double t, const double *x, const double *p, double *dx) {{\n",
-        f"    double f[{n}], lam[{m}];\n",
-        f"    const int err = accel_{k}(t, x, p, f, lam);\n    if (err) return err;\n",
-        f"    for (int i = 0; i < {n}; ++i) {{ dx[i] = x[{n} + i]; dx[{n} + i] = f[i]; }}\n",
-        "    return 0;\n}\n",
-        f"static int constraint_forces_{k}(double t, const double *x, const double *p, double *lam) {{\n",
-        f"    double f[{n}];\n    return accel_{k}(t, x, p, f, lam);\n}}\n"])
-
-
-#: Largest ``mh_k`` (operations of M, h, Γ) that is forced inline into ``rhs_k`` and ``dynamics_k``.
-INLINE_OPS = 400
-#: Characters of a reset's body above which it is compiled in the unit of its own (units.split_units).
-OWN_UNIT_CHARS = 40_000
 
 def generate(system: HybridSystem, derivatives: bool = False, hoist_params: bool = True) -> tuple[str, dict]:
     """Generate the C source of a system; returns (source, metadata for the loader). With
@@ -379,32 +279,6 @@ def _rhs_surfaces_code(k: int, nx: int, ntr: int, nsw: int) -> str:
     return "".join(body) + "    return 0;\n}\n\n"
 
 
-def _enabled_code(enabled: Any, nm: dict) -> str:
-    """The body of an enabling condition: the two sides of each comparison computed with shared
-    subexpressions first (a rigid-body tree's positions are shared graphs, which printed as one
-    expression would be written out at every use), then the condition of those values."""
-    head = "    (void)t; (void)x; (void)p;\n"
-    if enabled is None:
-        return head + "    return 1;\n}\n"
-    sides: list[sp.Expr] = []
-
-    def split(c: Any) -> Any:
-        if isinstance(c, (sp.And, sp.Or, sp.Not, sp.Xor)):
-            return c.func(*[split(a) for a in c.args])
-        if isinstance(c, Relational):
-            sides.extend([c.lhs, c.rhs])
-            syms = [sp.Symbol(f"e_{len(sides) - 2}", real=True), sp.Symbol(f"e_{len(sides) - 1}", real=True)]
-            return c.func(*syms, evaluate=False)
-        return c
-
-    cond = split(sp.sympify(enabled))
-    if not sides:
-        return head + f"    return ({_bool_block(cond, nm)}) ? 1 : 0;\n}}\n"
-    names = {**nm, **{sp.Symbol(f"e_{j}", real=True): f"e[{j}]" for j in range(len(sides))}}
-    body = f"    double e[{len(sides)}];\n" + _block([f"e[{j}]" for j in range(len(sides))], sides, nm)
-    return head + body + f"    return ({_bool_block(cond, names)}) ? 1 : 0;\n}}\n"
-
-
 def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     """Switching surfaces of a mode's right-hand side (forces, controllers, the mass matrix)."""
     eq, m = mi.equations, mi.model
@@ -412,63 +286,3 @@ def _mode_switches(mi: ModeInfo) -> list[sp.Expr]:
     if eq.holonomic is not None:  # a constraint written with Abs or Piecewise switches the flow too
         exprs += [*eq.holonomic.J, *eq.holonomic.gamma]
     return switching_surfaces(exprs, [*m.q, *m.qd, t])
-
-
-def _defs_code(defs: Any, nm: dict[sp.Symbol, str], hoist: Hoister) -> str:
-    """Statements of a rigid-body tree's named intermediate quantities (``k_i``), hoisted."""
-    rhs = hoist([e for _, e in defs])
-    pr = _Printer({**nm, **hoist.names})
-    return "\n".join(f"    const double {nm[s]} = {pr.doprint(e)};" for (s, _), e in zip(defs, rhs))
-
-
-def _reset_code(i: int, tr, src: ModeInfo, modes: dict[str, ModeInfo], nm: dict, params: list[str],
-                hoist: Hoister) -> str:
-    head = f"static int reset_{i}(double t, const double *x, const double *p, double *xout, int *target) {{\n"
-    head += "    (void)t; (void)x; (void)p; (void)xout;\n"
-    if tr.reset is None:
-        return head + f"    *target = {src.index};\n    return 0;\n}}\n"
-    dst = modes[tr.target]
-    m, eq = src.model, src.equations
-    n, nd = len(m.q), len(dst.model.q)
-    what = f"reset of transition {tr.name!r}"
-    body = f"    *target = {dst.index};\n"
-    reset = tr.reset
-    if reset.written is not None:  # written out: the target state as given
-        q_to, qd_to = reset.written
-        qn = target_exprs(dst.model, q_to, what, source=m)
-        vn = target_exprs(dst.model, qd_to, what, velocities=True, source=m)
-        body += f"    double y[{2 * nd}];\n"
-        body += _block([f"y[{j}]" for j in range(2 * nd)], hoist(qn + vn), {**nm, **hoist.names})
-        body += f"    for (int j = 0; j < {2 * nd}; ++j) xout[j] = y[j];\n    return 0;\n"
-        return head + body + "}\n"
-    prelude = ""
-    compact = eq.compact is not None  # a rigid-body tree: M with its named intermediate quantities
-    if compact:
-        eq = replace(eq, M=eq.compact[1])
-    imp = impulse_data(m, eq, reset, dst.model, what, compact=compact)  # Impact or Lock (validated when declared)
-    if compact:  # the impulse's named quantities: M's and those of the tree's impact blocks
-        defs = list(imp.defs) or eq.compact[0]
-        nm = {**nm, **{s: f"k_{i}" for i, (s, _) in enumerate(defs)}}
-        prelude = _defs_code(defs, nm, hoist)
-    Me, Jc, qn, dq = imp.Me, imp.Jc, imp.q_new, imp.velocity_map
-    ne, nc = Me.shape[0], Jc.shape[0]
-    body += f"    double Me[{ne * ne}], Jc[{nc * ne}], v[{ne}], qn[{nd}], T[{nd * n}];\n"
-    tg = [f"Me[{a * ne + b}]" for a in range(ne) for b in range(ne)]
-    ex = [Me[a, b] for a in range(ne) for b in range(ne)]
-    tg += [f"Jc[{a * ne + b}]" for a in range(nc) for b in range(ne)]
-    ex += [Jc[a, b] for a in range(nc) for b in range(ne)]
-    tg += [f"qn[{a}]" for a in range(nd)]
-    ex += qn
-    tg += [f"T[{a * n + b}]" for a in range(nd) for b in range(n)]
-    ex += [dq[a, b] for a in range(nd) for b in range(n)]
-    body += _block(tg, hoist(ex), {**nm, **hoist.names}, prelude=prelude)
-    body += f"    for (int j = 0; j < {ne}; ++j) v[j] = j < {n} ? x[{n} + j] : 0.0;\n"
-    body += f"    int err = amble_impulse({ne}, {nc}, Me, Jc, v);\n    if (err) return err;\n"
-    body += f"    for (int a = 0; a < {nd}; ++a) {{\n        double s = 0.0;\n"
-    body += f"        for (int b = 0; b < {n}; ++b) s += T[a * {n} + b] * v[b];\n"
-    body += f"        xout[a] = qn[a];\n        xout[{nd} + a] = s;\n    }}\n    return 0;\n"
-    if len(body) <= OWN_UNIT_CHARS:
-        return head + body + "}\n"
-    # a tree's impact map repeats M's named quantities: as large as mh_k, compiled beside it in the
-    # other unit (the 12-DOF walker: 9.4 s + 3.4 s of gcc become 5.8 s + 6.0 s on two cores)
-    return UNIT_BEGIN + "AMBLE_HIDDEN " + head.removeprefix("static ") + body + "}\n" + UNIT_END

@@ -29,7 +29,7 @@ from ..modelling.domain import Domain
 
 if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
-    from .kernels import Kernels
+    from .library import Kernels
 
 #: version of the :func:`describe` layout; a description of another version is not used
 FORMAT = 1
@@ -101,7 +101,7 @@ class CompiledSystem:
         self._open(info, libraries, loader)
 
     def _open(self, info: dict, libraries: Mapping[bool, tuple[Any, dict]], loader: Callable[[], Any]) -> None:
-        from .kernels import Kernels
+        from .library import Kernels
 
         self._info, self._loader, self._system = info, loader, None
         self.name: str = info["name"]

@@ -23,7 +23,7 @@ tensors): the same recursions written in world coordinates need every body's wor
 generated about twice the operations of the body-frame form. No expression is differentiated and
 every quantity is built once from its parent's (or its children's), so the result is a DAG whose
 size grows with the number of bodies times the depth (the entries of ``M``) and is linear
-otherwise; each intermediate is named (:class:`~amble.modelling.tree.Defs`), and the code
+otherwise; each intermediate is named (:class:`~amble.modelling.defs.Defs`), and the code
 generator emits the names as shared subexpressions. Exact zeros of sparse constants vanish.
 """
 
@@ -32,7 +32,9 @@ from __future__ import annotations
 import sympy as sp
 
 from ..modelling.constrained_tree import ConstrainedTree
-from ..modelling.tree import Defs, RigidTree, _cross, _dot, _matmul
+from ..modelling.defs import Defs
+from ..modelling.sparse_algebra import _cross, _dot, _matmul
+from ..modelling.tree import RigidTree
 
 
 class _Spatial:

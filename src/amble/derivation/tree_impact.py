@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..modelling.tree import RigidTree, _cross, _matmul
+from ..modelling.sparse_algebra import _cross, _matmul
+from ..modelling.tree import RigidTree
 from .tree import _Inertia, _Spatial, _Transform
 
 

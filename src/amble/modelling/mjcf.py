@@ -55,8 +55,8 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
+from .bodies import Joint
 from .dag import free_symbols
-from .tree import Joint
 
 #: MuJoCo's joint types (``mjtJoint``)
 _FREE, _BALL, _SLIDE, _HINGE = 0, 1, 2, 3

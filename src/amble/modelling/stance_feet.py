@@ -31,7 +31,8 @@ from .contact import heel_strike, height_above_slope
 from .dag import dag_subs
 from .hybrid import Guard
 from .model import Model
-from .tree import RigidTree, _mat3, _matmul, rpy_matrix
+from .sparse_algebra import _mat3, _matmul, rpy_matrix
+from .tree import RigidTree
 from .walker import Walker
 
 

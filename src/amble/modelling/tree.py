@@ -32,129 +32,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
+from .bodies import _COMPOSITE, JOINT_TYPES, Body, Joint
 from .defs import Defs
+from .sparse_algebra import _cross, _dot, _mat3, _matmul, _mul_add, _num, _rotation, _vec, rpy_matrix
 from .text import expr_of
 
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "spherical", "floating")
-#: the one-axis joints a spherical or floating joint stands for (suffix of the coordinate, type, axis):
-#: translations along the joint frame's x, y, z, then the rotation ``Rz(yaw) Ry(pitch) Rx(roll)``
-_COMPOSITE = {
-    "spherical": (("yaw", "revolute", (0, 0, 1)), ("pitch", "revolute", (0, 1, 0)), ("roll", "revolute", (1, 0, 0))),
-    "floating": (("x", "prismatic", (1, 0, 0)), ("y", "prismatic", (0, 1, 0)), ("z", "prismatic", (0, 0, 1)),
-                 ("yaw", "revolute", (0, 0, 1)), ("pitch", "revolute", (0, 1, 0)), ("roll", "revolute", (1, 0, 0))),
-}
-
-
-def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
-    """Rotation of URDF roll-pitch-yaw angles: ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-    r, p, y = (float(a) for a in rpy)
-    cr, sr, cp, sp_, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    ry = np.array([[cp, 0, sp_], [0, 1, 0], [-sp_, 0, cp]])
-    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    return rz @ ry @ rx
-
-
-def _num(x: Any) -> sp.Expr:
-    """A number or expression as sympy; integral floats become exact integers (sparser trees)."""
-    if isinstance(x, sp.Basic):
-        return x
-    v = float(x)
-    if v == 0.0:
-        return sp.Integer(0)
-    if v.is_integer() and abs(v) < 2**31:
-        return sp.Integer(int(v))
-    return sp.Float(v, 17)
-
-
-def _vec(xs: Any) -> sp.Matrix:
-    return sp.Matrix([_num(x) for x in xs])
-
-
-def _mat3(xs: Any) -> sp.Matrix:
-    if isinstance(xs, sp.MatrixBase):
-        return sp.Matrix(xs)
-    a = np.asarray(xs, dtype=object)
-    return sp.Matrix(3, 3, [_num(v) for v in a.reshape(-1)])
-
-
-def _rotation(axis: sp.Matrix, c: sp.Expr, s: sp.Expr) -> sp.Matrix:
-    """Rodrigues' rotation about a unit axis, by cos ``c`` and sin ``s`` (sparse for x, y, z)."""
-    x, y, z = axis
-    C = 1 - c
-    return sp.Matrix([
-        [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
-        [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
-        [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
-    ])
-
-
-@dataclass
-class Joint:
-    """A joint between a parent and a child body (see the module docstring for the types).
-
-    ``xyz``/``rpy`` (or ``rotation``, a 3×3 matrix) place the joint frame in the parent's frame;
-    ``post_xyz``/``post_rotation`` an optional fixed offset after the motion (a reversed joint,
-    when a tree is re-rooted). ``lower``/``upper`` are limits (``None``: none). ``mimic`` names
-    a model coordinate ``a`` that moves this joint by ``multiplier·a + offset`` (rad or m; a
-    joint with a mimic has no coordinate of its own and its limits are not the model's).
-    """
-
-    type: str = "revolute"
-    axis: Sequence[float] = (0.0, 0.0, 1.0)
-    xyz: Sequence[float] = (0.0, 0.0, 0.0)
-    rpy: Sequence[float] = (0.0, 0.0, 0.0)
-    rotation: Any = None
-    post_xyz: Sequence[float] | None = None
-    post_rotation: Any = None
-    lower: float | None = None
-    upper: float | None = None
-    mimic: str | None = None
-    multiplier: float = 1.0
-    offset: float = 0.0
-
-
-@dataclass
-class Body:
-    """A rigid body of a tree, with its world-frame kinematics once added."""
-
-    name: str
-    parent: Body | None
-    joint: Joint
-    mass: sp.Expr
-    com: sp.Matrix
-    inertia: sp.Matrix
-    #: the joint's angle or travel: a model coordinate, or ``k·a + c`` of one for a mimic joint
-    #: (None for a fixed joint)
-    coordinate: sp.Expr | None = None
-    #: index in the model's q of the coordinate that moves the joint (None for a fixed joint)
-    index: int | None = None
-    #: ∂(the joint's angle)/∂q[index]: 1, or a mimic joint's multiplier
-    multiplier: sp.Expr = field(default_factory=lambda: sp.Integer(1))
-    #: the joint's rate, ``multiplier · q̇[index]`` (zero for a fixed joint)
-    rate: sp.Expr = field(default_factory=lambda: sp.Integer(0))
-    R: sp.Matrix = field(default_factory=lambda: sp.eye(3))      # body → world
-    p: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))  # body origin, world
-    #: joint axis (world) and a point on it (world); zero axis for a fixed joint
-    axis_w: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
-    axis_point: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
-    omega: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))  # angular velocity, world
-    vel: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))    # velocity of the body origin
-
-    @property
-    def moving(self) -> bool:
-        return self.coordinate is not None
-
-    @property
-    def com_world(self) -> sp.Matrix:
-        return self.p + self.R * self.com
+__all__ = ["JOINT_TYPES", "Body", "Joint", "RigidTree", "rpy_matrix"]
 
 
 class RigidTree:
@@ -482,29 +371,3 @@ class RigidTree:
         d = self.defs
         b.R, b.p, b.omega, b.vel = d.vec(R), d.vec(p), d.vec(w), d.vec(v)
         b.axis_w, b.axis_point = d.vec(b.axis_w), d.vec(b.axis_point)
-
-
-def _matmul(A: sp.Matrix, B: sp.Matrix) -> sp.Matrix:
-    """Product that skips zero terms (constant rotations are sparse)."""
-    out = sp.zeros(A.rows, B.cols)
-    for i in range(A.rows):
-        for k in range(B.cols):
-            out[i, k] = sp.Add(*[A[i, j] * B[j, k] for j in range(A.cols) if A[i, j] != 0 and B[j, k] != 0])
-    return out
-
-
-def _dot(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
-    """Dot product that skips zero terms."""
-    return sp.Add(*[x * y for x, y in zip(a, b) if x != 0 and y != 0])
-
-
-def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
-    """Cross product that skips zero terms."""
-    def term(i: int, j: int) -> sp.Expr:
-        return a[i] * b[j] if a[i] != 0 and b[j] != 0 else sp.Integer(0)
-
-    return sp.Matrix([term(1, 2) - term(2, 1), term(2, 0) - term(0, 2), term(0, 1) - term(1, 0)])
-
-
-def _mul_add(A: sp.Matrix, x: sp.Matrix, y: sp.Matrix) -> sp.Matrix:
-    return _matmul(A, x) + y

@@ -226,9 +226,9 @@ def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: boo
     ``limits``: ``"ignore"`` (default) lets joints pass their limits as if they had none;
     ``"stop"`` ends the run where a joint reaches one (:meth:`HybridSystem.stop_at_limits`:
     status ``joint_limit``, the last event ``<coordinate>_<bound>_limit``)."""
+    from ..modelling.bodies import Joint
     from ..modelling.hybrid import HybridSystem
     from ..modelling.model import Model
-    from ..modelling.tree import Joint
 
     text = os.fspath(path)
     suffix = Path(text).suffix.lower()

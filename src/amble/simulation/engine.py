@@ -18,7 +18,8 @@ import numpy as np
 
 from ..backend import abi
 from ..backend.abi import CODE, CTX, CTX_X, IOPT, IOPT_FIELDS, OPT, OPT_FIELDS, OUTCOME, sens_layout
-from ..backend.kernels import Kernels, address
+from ..backend.c_args import address
+from ..backend.library import Kernels
 from ..errors import StateError
 
 #: Bytes a run may record (samples and events) before it ends as ``record_limit``: 512 MiB. The

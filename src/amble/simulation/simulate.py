@@ -17,7 +17,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..backend.abi import CODE, CTX, NEEDS_JACOBIAN
-from ..backend.kernels import Kernels, compiled
+from ..backend.kernels import compiled
+from ..backend.library import Kernels
 from ..errors import ParameterError, StateError
 from .engine import RECORD_BUDGET, Options, Run, run
 from .memo import Memo

@@ -20,7 +20,7 @@ from ..errors import AmbleError
 from . import inputs as _inputs
 
 if TYPE_CHECKING:
-    from ..backend.kernels import Kernels
+    from ..backend.library import Kernels
 
 
 @dataclass(slots=True)

@@ -17,7 +17,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ..modelling.tree import RigidTree, rpy_matrix
+from ..modelling.sparse_algebra import rpy_matrix
+from ..modelling.tree import RigidTree
 from ..simulation.trajectory import Trajectory
 
 __all__ = ["link_poses", "robot_file"]

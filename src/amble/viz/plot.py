@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.poincare import LimitCycle
+from ..analysis.limit_cycle import LimitCycle
 from ..simulation.trajectory import Trajectory
 
 

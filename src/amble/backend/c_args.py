@@ -1,0 +1,136 @@
+"""Arrays handed to compiled code and back: their addresses, shapes checked before any address
+reaches C, fresh output buffers, mode and transition indices by name or number.
+
+Apart from :class:`~amble.backend.library.Kernels`, which calls the library: these helpers know
+nothing of a library, only of the arrays and indices a call passes (a wrong shape raises the
+typed error of :mod:`amble.errors`, never a crash in C).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import operator
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError, StateError
+
+__all__ = ["address"]
+
+_dptr = ctypes.POINTER(ctypes.c_double)
+_iptr = ctypes.POINTER(ctypes.c_int)
+_i64ptr = ctypes.POINTER(ctypes.c_int64)
+
+
+def _p(a: np.ndarray) -> Any:
+    return a.ctypes.data_as(_dptr)
+
+
+_F64 = np.dtype(np.float64)
+_addressof = ctypes.addressof
+_bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1 byte, else an error
+_frombuffer = np.frombuffer
+_OUT: dict[int, type] = {}
+_NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
+_NO_PARAMS_ADDRESS = _NO_PARAMS.ctypes.data
+
+
+def _out(n: int) -> ctypes.Array:
+    """A fresh zeroed C array of ``n`` doubles: the output of one call, handed to C as it is and
+    returned as an ndarray over the same memory (cheaper than an ndarray's address)."""
+    t = _OUT.get(n)
+    if t is None:
+        t = _OUT[n] = ctypes.c_double * max(n, 1)
+    return t()
+
+
+def address(a: np.ndarray) -> int:
+    """The address of a C-contiguous array's data, several times cheaper than
+    ``a.ctypes.data`` (which builds a helper object per call) for a writable array."""
+    try:
+        return _addressof(_bytes_of(a))
+    except (TypeError, ValueError, BufferError):  # read-only or empty: the general way
+        if not a.flags.c_contiguous:
+            raise StateError("an array handed to compiled code must be C-contiguous") from None
+        return a.ctypes.data
+
+
+def _index(i: Any, n: int) -> int | None:
+    """An integer index in ``0 … n − 1`` (a NumPy integer too), else ``None``."""
+    if isinstance(i, bool):
+        return None
+    try:
+        i = operator.index(i)
+    except TypeError:
+        return None
+    return i if 0 <= i < n else None
+
+
+def _lookup(kind: str, key: Any, table: dict[str, int], n: int) -> int:
+    """The index of a mode or transition named by ``key`` (a name in ``table`` or an index below
+    ``n``); the slow path of ``Kernels.mode_index``/``transition_index``, whose plain-int test
+    stays inline because it runs on every per-state call."""
+    i = table.get(key) if isinstance(key, str) else _index(key, n)
+    if i is None:
+        raise ModelError(f"unknown {kind} {key!r}; {kind}s: {', '.join(table)} (or their indices 0 … {n - 1})")
+    return i
+
+
+def _arg(a: Any, n: int, error: type[Exception], what: str) -> tuple[int, np.ndarray]:
+    """The address of ``a`` as ``n`` float64 entries in a row, and the array at that address (it
+    must be kept alive until the call returns). A float64 C-contiguous writable ndarray of shape
+    ``(n,)`` is passed as it is; anything else of ``n`` entries is converted; another size raises
+    ``error`` — before any address reaches C."""
+    if type(a) is np.ndarray and a.dtype is _F64 and a.shape == (n,):
+        try:
+            return _addressof(_bytes_of(a)), a
+        except (TypeError, ValueError, BufferError):  # read-only, not contiguous, or empty
+            pass
+    try:
+        a = np.ascontiguousarray(a, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise error(f"{what} must be {n} real numbers, got {a!r}") from None
+    if a.shape != (n,):
+        raise error(f"{what} has {a.size} entries, expected {n}")
+    return a.ctypes.data, a
+
+
+def _matrix(a: Any, n: int, error: type[Exception], what: str) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array of rows of ``n`` entries (one row: a vector)."""
+    try:
+        a = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise error(f"{what} must be rows of {n} real numbers") from None
+    if a.ndim == 1 and a.shape == (n,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != n:
+        raise error(f"{what} must be rows of {n} entries, got shape {a.shape}")
+    return a
+
+
+def _vec(x: Any, n: int) -> np.ndarray:
+    x = np.ascontiguousarray(x, dtype=float).ravel()
+    if x.shape != (n,):
+        raise StateError(f"state has {x.size} entries, expected {n}")
+    return x
+
+
+def _rows(t: Any, modes: Any, x: Any, nx_max: int, n_modes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rows of (time, mode, state) for the row-wise kernels: equal lengths, modes in range, states
+    padded to ``nx_max``."""
+    t = np.ascontiguousarray(t, dtype=float).ravel()
+    modes = np.ascontiguousarray(modes, dtype=np.int32).ravel()
+    x = np.asarray(x, dtype=float)
+    if x.ndim == 1:
+        x = x[None, :]
+    if x.ndim != 2 or x.shape[1] > nx_max:
+        raise StateError(f"states must be rows of at most {nx_max} entries, got shape {x.shape}")
+    if not (len(t) == len(modes) == x.shape[0]):
+        raise StateError(f"row counts differ: {len(t)} times, {len(modes)} modes, {x.shape[0]} states")
+    if len(modes) and (modes.min() < 0 or modes.max() >= n_modes):
+        bad = int(modes[(modes < 0) | (modes >= n_modes)][0])
+        raise StateError(f"mode index {bad} out of range (the system has {n_modes} modes)")
+    if x.shape[1] < nx_max:
+        x = np.hstack([x, np.full((x.shape[0], nx_max - x.shape[1]), np.nan)])
+    return t, modes, np.ascontiguousarray(x)
