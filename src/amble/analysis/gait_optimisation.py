@@ -31,12 +31,14 @@ with exact sparse first and second derivatives; IPOPT solves it.
 from __future__ import annotations
 
 import time
+import weakref
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
+from ..backend.cache import fingerprint
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
 from ..errors import ParameterError, SolverError, StateError
 from ..modelling.hybrid import HybridSystem
@@ -142,7 +144,7 @@ def optimize_gait(
     pvs = [_parameters(system, {**pvals, **dict(sp_ or {})}) for sp_ in (step_params or [{}] * S)]
     model = system.modes[system.mode_names[0]]
     integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
-    fns = step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
+    fns = _step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
     n, nu, d = fns.n, fns.nu, fns.dims
     Ps = [np.array([pv[k] for k in fns.param_names]) for pv in pvs]
 
@@ -323,6 +325,28 @@ def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multip
         if max_multiplier is not None:
             raise
         return None
+
+
+#: the exported step functions per system (id, weak reference, its fingerprint and the objective's
+#: and phase's expressions): re-exporting RABBIT (its derivation and the translation to CasADi)
+#: costs 0.4 s of a 2 s design
+_EXPORTS: dict[tuple, tuple[Any, StepFunctions]] = {}
+
+
+def _step_functions(system: HybridSystem, integrand: sp.Expr | None, phase: sp.Expr | None) -> StepFunctions:
+    """:func:`~amble.backend.casadi_export.step_functions`, once per system and declaration:
+    any edit of a declaration advances its revision (:func:`amble.backend.cache.fingerprint`),
+    which makes a new key."""
+    key = (id(system), fingerprint(system), None if integrand is None else sp.srepr(integrand),
+           None if phase is None else sp.srepr(phase))
+    hit = _EXPORTS.get(key)
+    if hit is not None and hit[0]() is system:
+        return hit[1]
+    fns = step_functions(system, integrand, phase)
+    if len(_EXPORTS) >= 32:  # systems made per call would fill it
+        _EXPORTS.clear()
+    _EXPORTS[key] = (weakref.ref(system), fns)
+    return fns
 
 
 def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:
