@@ -152,7 +152,7 @@ def optimize_gait(
     guesses = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture, steps=S)
     x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
     total_iter, total_time = 0, 0.0
-    sigma = _momentum(fns, x_guesses[0], Ps[0], max_multiplier) if hzd and S == 1 else None
+    sigma = _momentum(fns, x_guesses[0], Ps[0], max_multiplier, hzd and S == 1)
 
     def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
               feasibility: bool = False, refine: bool = True) -> list[Gait]:
@@ -210,9 +210,8 @@ def optimize_gait(
                 add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
             if hzd:
                 add("virtual_constraints", virtual_constraints(fns, X, Pj, xg, AL))
-                if max_multiplier is not None:  # both ends on Z: δ_zero² is exact (see gait_stability)
-                    add("stability", restricted_multiplier(sigma, X[:, 0], X[:, -1], Pj, n), -np.inf,
-                        max_multiplier)
+                add("stability", _stability_row(ca, sigma, X, Pj, n, max_multiplier), -np.inf,
+                    max_multiplier or 1.0)
             if cot:  # |power| = its positive plus its negative part, each ≥ 0
                 add("power", U * fns.actuator_rates.map(K)(Q, V, Pj) - (PW[:nu, :] - PW[nu:, :]))
             run, scale = _running_cost(ca, fns, objective, U, PW, Q, V, taus, Pj)
@@ -298,10 +297,24 @@ def optimize_gait(
     assert warms is not None
     warm = warms[0] if S == 1 else period_gait(warms)
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
-    if sigma is not None:
-        value = float(restricted_multiplier(sigma, warm.fixed_point, warm.pre_impact_state, Ps[0], n))
-        warm.stability = {"restricted_multiplier": value, "max_multiplier": max_multiplier}
+    warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
     return warm
+
+
+def _stability_row(ca: Any, sigma: Any, X: Any, P: np.ndarray, n: int, max_multiplier: float | None) -> Any:
+    """The bounded multiplier ``δ_zero²`` of a step whose first and last points lie on ``Z`` (exact
+    there, see :mod:`~amble.analysis.gait_stability`), or nothing without a bound."""
+    if max_multiplier is None:
+        return ca.MX(0, 1)
+    return restricted_multiplier(sigma, X[:, 0], X[:, -1], P, n)
+
+
+def _stability_report(sigma: Any, gait: Gait, P: np.ndarray, n: int, max_multiplier: float | None
+                      ) -> dict[str, Any] | None:
+    if sigma is None:
+        return None
+    value = float(restricted_multiplier(sigma, gait.fixed_point, gait.pre_impact_state, P, n))
+    return {"restricted_multiplier": value, "max_multiplier": max_multiplier}
 
 
 def _check_stability_option(max_multiplier: float | None, hzd: bool, steps: int) -> None:
@@ -316,9 +329,12 @@ def _check_stability_option(max_multiplier: float | None, hzd: bool, steps: int)
         raise ParameterError(f"max_multiplier is for one-step gaits (steps=1), got steps={steps}")
 
 
-def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multiplier: float | None) -> Any:
-    """The zero dynamics' momentum σ (:func:`~amble.analysis.gait_stability.momentum_function`),
-    or None where it does not exist and no bound asks for it."""
+def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multiplier: float | None,
+              wanted: bool) -> Any:
+    """The zero dynamics' momentum σ (:func:`~amble.analysis.gait_stability.momentum_function`)
+    of a one-step HZD gait (``wanted``), or None where it does not exist and no bound asks for it."""
+    if not wanted:
+        return None
     try:
         return momentum_function(fns, x_guess, P)
     except ParameterError:
