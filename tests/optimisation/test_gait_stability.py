@@ -90,6 +90,36 @@ def test_the_closed_loops_multipliers_are_the_restricted_maps(gaits):
     assert cl_free["spectral_radius"] > BOUND + 0.05
 
 
+def test_the_bound_on_a_walker_whose_unactuated_direction_is_not_a_coordinate():
+    """The compass gait with a hip torque only (``B ∝ (−1, 1)``): the unactuated direction is
+    ``b⊥ ∝ (1, 1)``, turning both legs together (the angular momentum about the stance foot).
+    Bounded at 0.6 (its free optimum at 0.8 m/s, 3°: 0.663), the gait walked by a controller of
+    the exported virtual constraints (built here, ε = 0.005) has the bound as its dominant
+    multiplier (measured to 1e-12) and the transverse ones at 1e-13."""
+    from amble import find_fixed_point
+
+    def hip_only():
+        w = compass_gait.build()
+        m = w.modes["compass-gait"]
+        stance, swing = m.q
+        m.actuator("hip", on=swing - stance)
+        return w, m
+
+    w, _ = hip_only()
+    g = optimize_gait(w, params={"slope": 0.0524}, speed=0.8, nodes=[20, 60], bezier_degree=6, hzd=True,
+                      max_multiplier=0.6)
+    assert g.stability["restricted_multiplier"] == pytest.approx(0.6, abs=1e-8)
+    bz = g.bezier
+    loop, m = hip_only()
+    m.virtual_constraints([m.parse(o) for o in bz["outputs"]], m.parse(bz["phase"]["expression"]), bz["alpha"],
+                          (bz["phase"]["theta_plus"], bz["phase"]["theta_minus"]), epsilon=0.005)
+    lc = find_fixed_point(loop, g.fixed_point, params={"slope": 0.0524})
+    mods = np.sort(np.abs(lc.multipliers))[::-1]
+    assert lc.residual <= 1e-8
+    assert mods[0] == pytest.approx(g.stability["restricted_multiplier"], abs=1e-7)
+    assert mods[1] < 1e-3
+
+
 def test_stability_bound_errors():
     s = rabbit.build()
     for bad in (0.0, 1.0, float("nan"), -0.1):
