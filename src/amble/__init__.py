@@ -55,6 +55,7 @@ _WHERE: dict[str, str] = {
     "period_doublings": ".analysis.doublings",
     **dict.fromkeys(("hybrid_invariance_error", "invariant_parameters", "restricted_map"), ".analysis.hzd"),
     "optimize_gait": ".analysis.gait_optimisation",
+    "closed_loop_stability": ".analysis.gait_stability",
     **dict.fromkeys(("FirstPassage", "Terrain", "mfpt"), ".analysis.mfpt"),
     **dict.fromkeys(("MarkovPassage", "markov_mfpt"), ".analysis.markov"),
     **dict.fromkeys(("GaitSensitivity", "gait_sensitivity"), ".analysis.robustness"),

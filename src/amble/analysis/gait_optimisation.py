@@ -31,12 +31,14 @@ with exact sparse first and second derivatives; IPOPT solves it.
 from __future__ import annotations
 
 import time
+import weakref
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
+from ..backend.cache import fingerprint
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
 from ..errors import ParameterError, SolverError, StateError
 from ..modelling.hybrid import HybridSystem
@@ -44,6 +46,7 @@ from ..modelling.text import expr_of
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
 from .gait_result import Gait, bezier_fit, constraint_report
+from .gait_stability import momentum_function, restricted_multiplier
 from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
 from .solver_io import Interrupts, StdoutToStderr
@@ -84,6 +87,7 @@ def optimize_gait(
     progress: bool = False,
     steps: int = 1,
     step_params: Sequence[Mapping[str, float]] | None = None,
+    max_multiplier: float | None = None,
 ) -> Gait:
     """A periodic one-step gait of a one-mode walker that minimises ``objective``.
 
@@ -119,6 +123,12 @@ def optimize_gait(
     distance; ``step_params`` (one mapping per step) overrides parameter values step by step
     (e.g. leg masses of a robot whose legs differ, swapped from one step to the next). The
     result's fields are the first step's and :attr:`Gait.steps` holds every step.
+    ``max_multiplier``: an upper bound on the multiplier ``δ_zero²`` of the restricted Poincaré map
+    of an HZD gait (one step, one unactuated absolute angle; :mod:`~amble.analysis.gait_stability`),
+    the spectral radius of the closed loop under a fast enough output controller: e.g. ``0.5``.
+    An HZD gait reports ``δ_zero²`` in :attr:`Gait.stability`;
+    :func:`~amble.analysis.gait_stability.closed_loop_stability` adds the closed loop's
+    multipliers.
 
     Raises :class:`ParameterError` / :class:`StateError` / :class:`ModelError` on bad input and
     :class:`SolverError` (naming the reason and the most violated constraint) when IPOPT fails.
@@ -126,6 +136,7 @@ def optimize_gait(
     ca = casadi_module()
     hzd, bezier_degree = _check_options(system, speed, step_length, mu, step_time, clearance, nodes, hzd,
                                         bezier_degree, max_iter, steps)
+    _check_stability_option(max_multiplier, hzd, steps)
     S = steps
     pvals = _parameters(system, params)
     if step_params is not None and len(step_params) != S:
@@ -133,7 +144,7 @@ def optimize_gait(
     pvs = [_parameters(system, {**pvals, **dict(sp_ or {})}) for sp_ in (step_params or [{}] * S)]
     model = system.modes[system.mode_names[0]]
     integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
-    fns = step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
+    fns = _step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
     n, nu, d = fns.n, fns.nu, fns.dims
     Ps = [np.array([pv[k] for k in fns.param_names]) for pv in pvs]
 
@@ -141,6 +152,7 @@ def optimize_gait(
     guesses = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture, steps=S)
     x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
     total_iter, total_time = 0, 0.0
+    sigma = _momentum(fns, x_guesses[0], Ps[0], max_multiplier, hzd and S == 1)
 
     def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
               feasibility: bool = False, refine: bool = True) -> list[Gait]:
@@ -198,6 +210,8 @@ def optimize_gait(
                 add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
             if hzd:
                 add("virtual_constraints", virtual_constraints(fns, X, Pj, xg, AL))
+                add("stability", _stability_row(ca, sigma, X, Pj, n, max_multiplier), -np.inf,
+                    max_multiplier or 1.0)
             if cot:  # |power| = its positive plus its negative part, each ≥ 0
                 add("power", U * fns.actuator_rates.map(K)(Q, V, Pj) - (PW[:nu, :] - PW[nu:, :]))
             run, scale = _running_cost(ca, fns, objective, U, PW, Q, V, taus, Pj)
@@ -283,7 +297,72 @@ def optimize_gait(
     assert warms is not None
     warm = warms[0] if S == 1 else period_gait(warms)
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
+    warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
     return warm
+
+
+def _stability_row(ca: Any, sigma: Any, X: Any, P: np.ndarray, n: int, max_multiplier: float | None) -> Any:
+    """The bounded multiplier ``δ_zero²`` of a step whose first and last points lie on ``Z`` (exact
+    there, see :mod:`~amble.analysis.gait_stability`), or nothing without a bound."""
+    if max_multiplier is None:
+        return ca.MX(0, 1)
+    return restricted_multiplier(sigma, X[:, 0], X[:, -1], P, n)
+
+
+def _stability_report(sigma: Any, gait: Gait, P: np.ndarray, n: int, max_multiplier: float | None
+                      ) -> dict[str, Any] | None:
+    if sigma is None:
+        return None
+    value = float(restricted_multiplier(sigma, gait.fixed_point, gait.pre_impact_state, P, n))
+    return {"restricted_multiplier": value, "max_multiplier": max_multiplier}
+
+
+def _check_stability_option(max_multiplier: float | None, hzd: bool, steps: int) -> None:
+    if max_multiplier is None:
+        return
+    if not (isinstance(max_multiplier, (int, float)) and np.isfinite(max_multiplier) and 0 < max_multiplier < 1):
+        raise ParameterError(f"max_multiplier must be a number in (0, 1), got {max_multiplier!r}")
+    if not hzd:
+        raise ParameterError("max_multiplier bounds the restricted Poincaré map of the hybrid zero dynamics: it "
+                             "needs hzd=True (virtual constraints)")
+    if steps != 1:
+        raise ParameterError(f"max_multiplier is for one-step gaits (steps=1), got steps={steps}")
+
+
+def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multiplier: float | None,
+              wanted: bool) -> Any:
+    """The zero dynamics' momentum σ (:func:`~amble.analysis.gait_stability.momentum_function`)
+    of a one-step HZD gait (``wanted``), or None where it does not exist and no bound asks for it."""
+    if not wanted:
+        return None
+    try:
+        return momentum_function(fns, x_guess, P)
+    except ParameterError:
+        if max_multiplier is not None:
+            raise
+        return None
+
+
+#: the exported step functions per system (id, weak reference, its fingerprint and the objective's
+#: and phase's expressions): re-exporting RABBIT (its derivation and the translation to CasADi)
+#: costs 0.4 s of a 2 s design
+_EXPORTS: dict[tuple, tuple[Any, StepFunctions]] = {}
+
+
+def _step_functions(system: HybridSystem, integrand: sp.Expr | None, phase: sp.Expr | None) -> StepFunctions:
+    """:func:`~amble.backend.casadi_export.step_functions`, once per system and declaration:
+    any edit of a declaration advances its revision (:func:`amble.backend.cache.fingerprint`),
+    which makes a new key."""
+    key = (id(system), fingerprint(system), None if integrand is None else sp.srepr(integrand),
+           None if phase is None else sp.srepr(phase))
+    hit = _EXPORTS.get(key)
+    if hit is not None and hit[0]() is system:
+        return hit[1]
+    fns = step_functions(system, integrand, phase)
+    if len(_EXPORTS) >= 32:  # systems made per call would fill it
+        _EXPORTS.clear()
+    _EXPORTS[key] = (weakref.ref(system), fns)
+    return fns
 
 
 def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:

@@ -63,6 +63,11 @@ class Gait:
     #: fields above are then the first step's, except ``speed`` (the period's: Σ L / Σ T) and
     #: ``objective`` (the period's). None for a one-step gait
     steps: list[Gait] | None = None
+    #: an HZD gait's stability (:mod:`~amble.analysis.gait_stability`): ``restricted_multiplier``
+    #: (``δ_zero²``, the multiplier of the restricted Poincaré map), ``max_multiplier`` (its bound
+    #: in the optimisation, or None) and, once checked, ``closed_loop`` (the full-order multipliers
+    #: of the closed loop). None when the restricted map is not one-dimensional-affine
+    stability: dict[str, Any] | None = None
 
     def state(self, t: Any) -> np.ndarray:
         """The collocation solution at times ``t`` (s, within the step), by its Hermite interpolant."""
@@ -123,7 +128,7 @@ class Gait:
                            "accelerations": self.accelerations.tolist(), "inputs": self.inputs.tolist(),
                            "contact_force": None if self.contact_forces is None else self.contact_forces.tolist()},
             "constraints": self.constraints, "max_violation": self.max_violation,
-            "bezier": self.bezier, "solver": self.solver,
+            "bezier": self.bezier, "stability": self.stability, "solver": self.solver,
             **({"period": len(self.steps), "steps": [_step_json(g) for g in self.steps]} if self.steps else {}),
         }
 

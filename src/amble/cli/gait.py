@@ -68,6 +68,8 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
     if not 1 <= args.steps <= 8:
         raise UsageError(f"--steps must be in [1, 8], got {args.steps}")
+    if args.max_multiplier is not None and not 0 < args.max_multiplier < 1:
+        raise UsageError(f"--max-multiplier must be in (0, 1), got {args.max_multiplier:g}")
     bounds = parse_bounds(args.bound)
     guess = _guess(args.guess)
     s = load_model(args.model)
@@ -82,7 +84,12 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
                          nodes=nodes if len(nodes) > 1 else nodes[0], guess=guess, step_time=args.step_time,
                          posture=posture, mu=args.mu,
                          clearance=args.clearance, bounds=bounds, max_iter=args.max_iter, hzd=args.hzd,
-                         bezier_degree=args.bezier_degree, progress=not args.quiet, steps=args.steps)
+                         bezier_degree=args.bezier_degree, progress=not args.quiet, steps=args.steps,
+                         max_multiplier=args.max_multiplier)
+    if args.max_multiplier is not None and gait.bezier and "params" in gait.bezier:
+        from ..analysis.gait_stability import closed_loop_stability
+
+        closed_loop_stability(s, gait)  # the closed loop's own multipliers, independent of the bound's formula
     out = gait.to_json()
     if out_p:
         write_output(out_p, gait.save, "--out")
@@ -96,6 +103,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
         print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(gait.state_names, gait.fixed_point)))
         for j, step in enumerate(gait.steps or []):
             print(f"step {j + 1}: step time {step.step_time:.6g} s, step length {step.step_length:.6g} m")
+        _print_stability(gait.stability)
         active = [k for k, r in gait.constraints.items() if r["active"]]
         if active:
             print("active constraints: " + ", ".join(active))
@@ -104,6 +112,20 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
     else:
         out.pop("trajectory")  # the trajectory goes to the file, the summary to stdout
     return out
+
+
+def _print_stability(st: dict[str, Any] | None) -> None:
+    if not st:
+        return
+    bound = f" (bound {st['max_multiplier']:g})" if st.get("max_multiplier") is not None else ""
+    line = f"restricted Poincaré map multiplier δ_zero² {st['restricted_multiplier']:.6g}{bound}"
+    cl = st.get("closed_loop")
+    if cl and "error" in cl:
+        line += f"; closed loop not found: {cl['error']}"
+    elif cl:
+        line += (f"; closed loop: spectral radius {cl['spectral_radius']:.6g}, next multiplier modulus "
+                 f"{(abs(complex(*cl['multipliers'][1])) if len(cl['multipliers']) > 1 else 0.0):.3g}")
+    print(line)
 
 
 def add_parser(add: Any, model_arg: Any) -> None:
@@ -139,6 +161,11 @@ def add_parser(add: Any, model_arg: Any) -> None:
                         "that declares virtual constraints)")
     o.add_argument("--bezier-degree", type=int, default=None, dest="bezier_degree",
                    help="degree of the Bézier virtual constraints (default: the model's own, else 5)")
+    o.add_argument("--max-multiplier", type=float, dest="max_multiplier", metavar="R",
+                   help="bound the multiplier δ_zero² of the HZD gait's restricted Poincaré map by R in (0, 1) "
+                        "(the closed loop's spectral radius under a fast output controller), then find the "
+                        "closed loop's multipliers (a model with its own virtual constraints: its controller "
+                        "is compiled once)")
     o.add_argument("--steps", type=int, default=1,
                    help="steps per period (default 1; 2: a two-step gait, each step with its own impact)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
