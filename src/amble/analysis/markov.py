@@ -1,25 +1,40 @@
 """The mean first-passage time from a Markov chain on a mesh of the section (Byl & Tedrake 2009).
 
-The terrain's law is replaced by a quadrature (the midpoints in probability of ``nodes`` equally
-likely intervals; a tensor product for several drawn parameters), and the set of
-post-impact states by a finite **mesh** grown from the gait: starting from the gait's post-impact
-state at the terrain's mean, every new mesh state is walked one step on every quadrature node (all
-of them in one compiled call per wave, :func:`amble.simulation.engine.walk_many`), and an image
-farther than ``spacing`` from every mesh state (in the scaled distance below) becomes a new mesh
-state, until no image is new or ``max_states`` is reached (Byl & Tedrake's sampled mesh: only
-states the walker can reach are meshed, whatever the dimension of the section).
+The terrain's law is replaced by a quadrature (``nodes`` equally likely intervals, each
+represented by the law's conditional mean on it; a tensor product for several drawn parameters),
+and the set of post-impact states by a finite **mesh** grown from the gait: starting from the
+gait's post-impact state at the terrain's mean, every new mesh state is walked one step on every
+quadrature node (all of them in one compiled call per wave,
+:func:`amble.simulation.engine.walk_many`), and an image farther than ``spacing`` from every mesh
+state (in the scaled distance below) becomes a new mesh state, until no image is new or
+``max_states`` is reached (Byl & Tedrake's sampled mesh: only states the walker can reach are
+meshed, whatever the dimension of the section).
 
-Distances are measured in each state coordinate divided by its spread over the images of the
-gait (the standard deviation of two steps' images from the gait), so ``spacing`` is relative.
-An image is assigned to the mesh by linear (barycentric) interpolation over a Delaunay
-triangulation of the mesh when the section has at most :data:`LINEAR_MAX_DIM` coordinates that
-vary, and to its nearest mesh state otherwise (or when it lies outside the triangulation).
+**Where states are compared** (``mesh``). A post-impact state lies on the section of the step
+that ended it, and when the drawn parameters enter that step's guard or reset (a footfall on a
+ramp of angle γ: the legs' angles are tied by γ) each terrain node has a section of its own, of
+one dimension less than the state. With ``mesh="section"`` (the default) the mesh is kept in
+**slices**, one per node — the images of that node's steps — and states are compared, and images
+interpolated, only within their slice, in the chart coordinates of the gait's section
+(:func:`amble.analysis.section.chart`: derived from the model's guard and reset, nothing keyed on
+a coordinate's name): the compass gait's four post-impact coordinates become three per slice,
+and an image is interpolated exactly on the section it lies on. When the drawn parameters leave
+the section where it is, or with ``mesh="state"``, every state coordinate that varies is used and
+the mesh has one slice.
+
+Distances are measured in each coordinate divided by its spread over the images of the gait (the
+standard deviation of two steps' images from the gait), so ``spacing`` is relative. An image is
+assigned to the mesh states of its slice by linear (barycentric) interpolation over a Delaunay
+triangulation (between the two neighbours on a line) when the slice has at most
+:data:`LINEAR_MAX_DIM` coordinates, and to its nearest mesh state otherwise (or when it lies
+outside the triangulation).
 
 **The fall.** Whether a step ends in a fall jumps with the drawn parameter, which no quadrature
 integrates better than to a node's width (a 2 % error at 16 nodes on the rimless wheel). With one
 drawn parameter, the parameter where the outcome changes between two neighbouring nodes is found
 by bisection for every mesh state, and each node's weight is the probability of the part of its
-interval on its own side of the change (:func:`_edges`).
+interval on its own side of the change (:func:`_edges`); a fall in the law's tails beyond the
+outer nodes is found the same way.
 
 The chain's states are the mesh states and an absorbing *fallen* state; ``Q`` is the chain among
 the mesh states. The expected number of steps until a fall (the falling step counted, as the
@@ -30,10 +45,13 @@ whose first is the fallen state's 1), ``1 / (1 − λ₂)``, is the MFPT from th
 after its transient; it is reported as ``mfpt_eigen``, the distribution as ``metastable``.
 
 **Convergence.** The chain is built at ``levels`` spacings, each half the one before; the
-result carries the MFPT at every level, and its ``ci_low``/``ci_high`` are the two finest
-levels' values — a measure of the discretisation's error, not a confidence interval. A level's
-``complete`` is false when its mesh was cut at ``max_states`` before every reachable state was
-meshed: images beyond it go to their nearest mesh state, and its value is not to be trusted.
+result carries the MFPT at every level. When the last three levels' differences shrink without
+changing sign, Richardson's extrapolation with the order they show gives ``extrapolated`` (the
+limit of zero spacing) and ``order``. ``ci_low``/``ci_high`` span the two finest levels' values
+and the extrapolated limit — the stated discretisation uncertainty, not a confidence interval. A
+level's ``complete`` is false when its mesh was cut at ``max_states`` before every reachable
+state was meshed: images beyond it go to their nearest mesh state, and its value is not to be
+trusted (nor extrapolated from).
 """
 
 from __future__ import annotations
@@ -432,7 +450,10 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
 
     ``spacing``: the finest mesh spacing, relative to the spread of the gait's images;
     ``levels``: chains built at ``spacing · 2^(levels−1)``, …, ``spacing`` (the convergence
-    shown); ``nodes``: quadrature nodes per drawn parameter; ``max_states``: the mesh's cap;
+    shown; three or more for a Richardson limit); ``nodes``: quadrature nodes per drawn
+    parameter; ``max_states``: the mesh's cap; ``bisections``: walks that locate each change of
+    outcome between nodes; ``mesh``: ``"section"`` (slices on each node's section, the chart's
+    coordinates) or ``"state"`` (every state coordinate), see the module docstring;
     ``params``, ``start``, ``threads``, ``opts`` as for :func:`amble.analysis.mfpt.mfpt`."""
     for name, v, low in (("levels", levels, 1), ("nodes", nodes, 1), ("max_states", max_states, 2),
                          ("bisections", bisections, 0), ("threads", threads, 1)):
