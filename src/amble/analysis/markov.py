@@ -63,7 +63,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, SimulationError
 from ..simulation.engine import CODE, Options, walk_many
 from .mfpt import Terrain, terrain_start
 
@@ -197,7 +197,10 @@ def _section_chart(system: Any, params: Mapping[str, float], cols: list[int], va
     from .section import Section
 
     rm = ReturnMap(system, params)
-    sec = Section.of(rm, x0)
+    try:
+        sec = Section.of(rm, x0)
+    except SimulationError:  # a start that falls on the mean terrain: no footfall to chart from
+        return np.arange(x0.size), False
     g0, r0 = sec.guard(sec.pre), sec.reset(sec.pre)
     moved = False
     for row in (values.min(axis=0), values.max(axis=0)):
@@ -248,15 +251,16 @@ def _edges(step: _Stepper, law: Any, X: np.ndarray, ok: np.ndarray,
     drawn parameter, is integrated to the bisection's resolution instead of to a node's width.
     The outer nodes own the law's tails: each state is also walked at the quantiles :data:`TAIL`
     and ``1 − TAIL``, and where an outer node walks and its probe falls, the change between them
-    is found the same way and the probability beyond it is a fall (else a tail that falls beyond
-    the outer node, ``1/(2·nodes)`` of the law at most, would count as walking)."""
+    is found by bisection in the logarithm of the probability beyond (half as many walks) and that
+    probability is a fall (else a tail that falls beyond the outer node, up to ``1/nodes`` of the
+    law, would count as walking)."""
     n, rows = step.nq, np.arange(len(X))
     g = step.values[:, 0]
     probe = law.ppf([TAIL, 1.0 - TAIL])
     walks_lo = step.walk(X, np.full((len(X), 1), probe[0]))[1]
     walks_hi = step.walk(X, np.full((len(X), 1), probe[1]))[1]
     # the edges of the nodes' intervals (the outer ones at ±∞), for every state: moved to the
-    # outcome's change below; bisections between nodes and at the tails are done together
+    # outcome's change below
     cut = np.c_[np.full(len(X), -np.inf), np.tile(law.ppf(np.arange(1, n) / n), (len(X), 1)),
                 np.full(len(X), np.inf)]
     i, j = np.nonzero(ok[:, :-1] != ok[:, 1:])
@@ -264,7 +268,8 @@ def _edges(step: _Stepper, law: Any, X: np.ndarray, ok: np.ndarray,
         lo, hi = np.full(len(i), g[j]), np.full(len(i), g[j + 1])
         for _ in range(bisections):
             mid = 0.5 * (lo + hi)
-            same = step.walk(X[i], mid[:, None])[1] == ok[i, j]  # the outcome of the left node: the change is to the right
+            # the outcome of the left node: the change is to the right
+            same = step.walk(X[i], mid[:, None])[1] == ok[i, j]
             lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         cut[i, j + 1] = 0.5 * (lo + hi)
     # the tails: bisected in the logarithm of the probability beyond, where a few halvings place
