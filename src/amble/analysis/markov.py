@@ -65,7 +65,7 @@ import numpy as np
 
 from ..errors import ParameterError, SimulationError
 from ..simulation.engine import CODE, Options, walk_many
-from .mfpt import Terrain, terrain_start
+from .mfpt import Terrain, terrain_start, walk_options
 
 #: how mesh states are compared: in the chart of each terrain node's section, or in every state coordinate
 MESHES = ("section", "state")
@@ -472,7 +472,8 @@ def markov_mfpt(system: Any, terrain: Terrain, *, spacing: float = 0.05, levels:
     draws, weights = quadrature(terrain, nodes)
     one = next(iter(terrain.draws.values()))
     law = _law(*one) if len(terrain.draws) == 1 and not _fixed(*one) else None
-    step = _Stepper(k, p0, [names.index(n) for n in terrain.draws], draws, mode, x0, opts or Options(), threads)
+    step = _Stepper(k, p0, [names.index(n) for n in terrain.draws], draws, mode, x0, walk_options(system, opts),
+                    threads)
     # the scale of each coordinate: the spread of two steps' images of the gait
     Y1, ok1 = step.images(x0[None, :])
     Y2, ok2 = step.images(Y1[ok1]) if ok1.any() else (Y1[:0], ok1[:0])
