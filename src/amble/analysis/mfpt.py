@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -122,6 +122,22 @@ def _rate_interval(falls: int, steps: int, confidence: float) -> tuple[float, fl
     return float(low), float(high)
 
 
+#: the longest a walker goes without a footfall (s) where neither the options nor the system bound it
+NO_FOOTFALL = 10.0
+
+
+def walk_options(system: Any, opts: Options | None) -> Options:
+    """``opts`` (default :class:`Options`) with a bound on the time without a footfall: the
+    options' own, else the system's ``max_step_time``, else :data:`NO_FOOTFALL`. Without one, a
+    walker that a drawn terrain turns round (a rimless wheel rolling back down an uphill draw)
+    walks on until the integrator's step cap, minutes for a batch; with it, that walker has
+    fallen when the bound passes."""
+    opts = opts or Options()
+    if opts.max_step_time > 0:
+        return opts
+    return replace(opts, max_step_time=float(getattr(system, "max_step_time", 0.0)) or NO_FOOTFALL)
+
+
 def terrain_start(system: Any, terrain: Terrain, params: Mapping[str, float] | None,
                   start: Sequence[float] | None) -> tuple[Any, list[str], np.ndarray, np.ndarray, int]:
     """The compiled kernels, their parameter names, the parameter vector at the terrain's mean
@@ -159,7 +175,7 @@ def mfpt(system: Any, terrain: Terrain, *, runs: int = 1000, max_steps: int = 10
     X = np.tile(x0, (runs, 1))
     alive = np.ones(runs, bool)
     walked = np.zeros(runs, np.int64)
-    opts = opts or Options()
+    opts = walk_options(system, opts)
     for _ in range(max_steps):
         idx = np.flatnonzero(alive)
         if idx.size == 0:

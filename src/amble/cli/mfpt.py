@@ -35,6 +35,9 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
                    help="markov: finest mesh spacing, relative to the spread of the gait's images (default 0.05)")
     m.add_argument("--levels", type=int, default=3, help="markov: meshes, each spacing half the one before (default 3)")
     m.add_argument("--max-states", type=int, default=20_000, help="markov: mesh states at most (default 20000)")
+    m.add_argument("--mesh", choices=("section", "state"), default="section",
+                   help="markov: compare mesh states in the chart coordinates of each terrain node's own "
+                        "post-impact section (section) or in every state coordinate (state; default section)")
     m.add_argument("--plot", help="markov: draw the metastable distribution on the section to FILE.png|.svg|.pdf")
     m.set_defaults(func=cmd_mfpt)
 
@@ -72,7 +75,8 @@ def _markov(args: argparse.Namespace, system: Any, terrain: Any, plot_p: Path | 
     from ..analysis.markov import markov_mfpt
 
     r = markov_mfpt(system, terrain, spacing=args.spacing, levels=args.levels, nodes=args.nodes,
-                    max_states=args.max_states, params=parse_sets(args.set), threads=args.threads)
+                    max_states=args.max_states, mesh=args.mesh, params=parse_sets(args.set),
+                    threads=args.threads)
     out = {**r.to_json(), "state_names": system.state_names()}
     if plot_p:
         from ..viz.metastable import plot_metastable
