@@ -120,3 +120,15 @@ def test_limit_cycle_tol_bounds_the_residual(capsys):
     code, _, err = run(capsys, "sweep", "compass-gait", "--kind", "bifurcation", "--param", "slope=0.01:0.02:2",
                        "--tol", "1e-9")
     assert code == 2 and "--tol applies to" in err
+
+
+def test_a_period_beyond_the_return_maps_bound_is_refused_before_any_work(capsys, monkeypatch):
+    # one bound for the command line and the return map: refused before the model is loaded
+    cli = sys.modules["amble.cli.main"]
+
+    def no_load(*a, **k):
+        raise AssertionError("the model was loaded")
+
+    monkeypatch.setattr(cli, "load_model", no_load)
+    code, _, err = run(capsys, "limit-cycle", "compass-gait", "--period", "65")
+    assert code == 2 and err.strip() == "amble: error: --period must be at least 1 and at most 64, got 65"

@@ -46,9 +46,6 @@ from .prefetch import prefetch_plotting
 from .robustness import EXAMPLE as ROBUSTNESS_EXAMPLE
 from .robustness import add_parser as add_robustness_parser
 
-#: Largest ``--period`` of ``limit-cycle``: a period-k search walks k steps per Newton iteration.
-MAX_PERIOD = 1000
-
 MODEL_HELP = ("a library model (see 'amble models'), a model file path/to/file.py[:callable]: the callable, "
               "else the file's build(), else the one HybridSystem it defines, or a robot file path/to/robot.urdf "
               "(floating base, or --fixed-base) or MuJoCo's path/to/robot.xml (as the file says, or --fixed-base)")
@@ -209,6 +206,10 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         from ..viz.movie import check_writer
 
         check_writer(anim_p)
+    # the return map's own bound (a period-k search walks k steps per Newton iteration), checked
+    # before the model is loaded
+    from ..analysis.return_map import MAX_PERIOD
+
     if not 1 <= args.period <= MAX_PERIOD:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
     # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
