@@ -112,7 +112,6 @@ def test_an_earlier_cache_is_adopted_and_the_default_place_always(tmp_path, monk
     s = _pendulum("earlier-cache")
     so = kernels.compiled(s).path
     (d / cache_home.TAG).unlink()
-    monkeypatch.setattr(kernels, "_BUILT", {}, raising=False)
     with warnings.catch_warnings():
         warnings.simplefilter("error", cache_home.CacheWarning)
         assert cache.cache_dir() == d and (d / cache_home.TAG).is_file()
