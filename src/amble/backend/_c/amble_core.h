@@ -40,7 +40,7 @@
 /* Solve A x = b for symmetric positive definite A by LDL^T (A = L D L^T, L unit lower
  * triangular): no square root; the failure test (a pivot D_j not positive, or max D / min D > 1e14, a lower
  * bound of cond(A)). The lower triangle of A is overwritten by L, b by x. Generated right-hand
- * sides of small systems write this solve out unrolled (backend/codegen.py); larger ones call it. */
+ * sides of small systems write this solve out unrolled (backend/ldl.py); larger ones call it. */
 static int amble_ldl_solve(int n, double *A, double *b) {
     double D[n], u[n];
     double dmin = INFINITY, dmax = 0.0;
