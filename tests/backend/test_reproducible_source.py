@@ -1,7 +1,7 @@
 """The generated C source is a function of the model declaration alone: processes with different
 string-hash seeds (``PYTHONHASHSEED``) write byte-identical translation units under one cache key.
 The humanoid's derivative kernels once differed between seeds: the partial derivatives of a
-contact force's ``Piecewise`` were taken in the iteration order of a set of symbols."""
+step-length torque (a ``Piecewise``) were taken in the iteration order of a set of symbols."""
 
 from __future__ import annotations
 
