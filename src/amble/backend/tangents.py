@@ -44,6 +44,11 @@ class _Program:
                  defs: Sequence[tuple[sp.Symbol, sp.Expr]], indent: str) -> None:
         self.index = {s: i for i, s in enumerate(inputs)}
         self.defs = dict(defs)
+        # the symbols that carry derivatives in a fixed order, intermediates (as defined) then
+        # inputs: a set of symbols iterates in an order that changes with the string-hash seed
+        self.rank: dict[sp.Basic, int] = {}
+        for s in [*self.defs, *inputs]:
+            self.rank.setdefault(s, len(self.rank))
         self.names = dict(names)
         for i, (s, _) in enumerate(defs):
             self.names.setdefault(s, f"k_{i}")
@@ -77,8 +82,9 @@ class _Program:
             return []
         if isinstance(e, (sp.Add, sp.Mul, sp.sin, sp.cos)) or (isinstance(e, sp.Pow) and e.exp.is_Number):
             return e.args
-        # another function: kept whole, its free symbols that carry derivatives first
-        return [s for s in e.free_symbols if s in self.defs or s in self.index]
+        # another function: kept whole, its free symbols that carry derivatives first (in rank
+        # order, so that the generated text does not depend on the process's hash seed)
+        return sorted((s for s in e.free_symbols if s in self.rank), key=self.rank.__getitem__)
 
     def _combine(self, e: sp.Basic, kids: list[_Node]) -> _Node:
         if e in self.defs:  # a named intermediate: its own name, the definition's derivatives
