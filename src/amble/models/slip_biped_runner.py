@@ -65,13 +65,13 @@ name       default       unit   meaning
 ``v0``     5.0           m/s    forward speed at that apex
 =========  ============  =====  ===========================================================
 
-At the defaults the running gait has its apex 1.183449 m high (forward speed 4.8342 m/s) and
-steps 3.077 m in 0.64686 s; the leg lands at 66.06° after 0.2344 s of descent and the flight
-phases (lift-off to touchdown) last 0.4689 s of the step. Its multiplier is −0.0387: the
-retraction makes it nearly deadbeat. The same gait run with the leg held fixed at its touchdown
-angle (``alpha`` = 66.06°, ``omega = 0``, the same trajectory) is unstable, multiplier 1.321:
-the stability is the controller's. Without retraction at the default ``alpha`` = 52° there is
-no running gait at all: the apex rises from step to step.
+At the defaults the running gait has its apex 1.183449 m high (forward speed 4.8335 m/s) and
+steps 3.0772 m in 0.64686 s; the leg lands at 66.063° after 0.2344 s of descent, the stance lasts
+0.1781 s and the flight phases (lift-off to touchdown) 0.4688 s of the step. Its multiplier is
+−0.0387: the retraction makes it nearly deadbeat. The same gait run with the leg held fixed at
+its touchdown angle (``alpha`` = 66.063°, ``omega = 0``: the same trajectory) is unstable,
+multiplier +1.321: the stability is the controller's. Without retraction at the default
+``alpha`` = 52° there is no running gait at all: every apex is followed by a higher one.
 """
 
 from __future__ import annotations
