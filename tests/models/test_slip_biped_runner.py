@@ -142,3 +142,24 @@ def test_viewer_shows_the_flight_phase(capsys, tmp_path):
     y = o.fixed_point(1.18)
     ref = o.stride(y)
     assert abs((ref["t_td"] + ref["t_apex"] - ref["t_lo"]) / ref["t_apex"] - 0.725) < 0.01
+
+
+def test_closed_loop_recovers_where_the_fixed_leg_drifts_away(gait):
+    o, y, _ = gait
+    # retracting: from apexes 8 cm below and 12 cm above the gait's, back to it within 8 steps,
+    # apex by apex as the SciPy runner's map iterates
+    for h in (1.10, 1.30):
+        run = amble.simulate(build(), _apex(o, h, PARAMS["alpha"], PARAMS["omega"]), steps=8, rtol=1e-12,
+                             atol=1e-12, samples=False)
+        apexes = [e.x_post[1] for e in run.events if e.name == "apex"]
+        ref = [h]
+        for _ in range(8):
+            ref.append(o.apex_map(ref[-1]))
+        assert np.max(np.abs(np.array(apexes) - ref[1:])) <= 1e-9
+        assert abs(apexes[-1] - y) <= 1e-8
+    # the leg fixed at the gait's touchdown angle: 1 mm off the gait grows step by step
+    fixed = o.fixed_angle(y)
+    run = amble.simulate(build(), _apex(fixed, y + 1e-3, fixed.alpha, 0.0), steps=8, rtol=1e-12, atol=1e-12,
+                         params={"alpha": fixed.alpha, "omega": 0.0}, samples=False)
+    off = [e.x_post[1] - y for e in run.events if e.name == "apex"]
+    assert all(b > a > 0 for a, b in zip(off, off[1:])) and off[-1] > 5e-3
