@@ -219,16 +219,38 @@ class Trajectory:
         ev_iter = iter(self.events)
         ev = next(ev_iter, None)
         n = len(self.t)
+
+        def moved(at: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+            """The frame after ``ev``: ``at``, the points where it happened (else from its state)."""
+            shift, flip = changes[ev.name]
+            o = origin
+            if shift is not None:
+                if at is None:
+                    at = self.kernels.kinematics_rows([ev.t], [self.kernels.mode_index(ev.source)],
+                                                      ev.x_pre, self.params)[0][0]
+                o = origin + frame @ at[pidx[shift]]
+            return o, frame @ np.diag(flip)
+
         for i in range(n):
+            # events between rows (a run recorded without samples keeps only its ends): their
+            # frame changes still accumulate, from each event's own pre-impact state
+            while ev is not None and (ev.t < self.t[i] or self._lone_post_row(i, ev)):
+                origin, frame = moved(None)
+                ev = next(ev_iter, None)
             origins[i], frames[i] = origin, frame
             # an event writes a pre row then a post row at the same time
             if ev is not None and i + 1 < n and self.t[i] == ev.t and self.t[i + 1] == ev.t:
-                shift, flip = changes[ev.name]
-                if shift is not None:
-                    origin = origin + frame @ pos[i, pidx[shift]]
-                frame = frame @ np.diag(flip)
+                origin, frame = moved(pos[i])
                 ev = next(ev_iter, None)
         return origins, frames
+
+    def _lone_post_row(self, i: int, ev: Any) -> bool:
+        """Whether row ``i`` is ``ev``'s post-impact state without its pre row (the last row of a
+        run recorded without samples, which ends just after a footfall)."""
+        if self.t[i] != ev.t or (i + 1 < len(self.t) and self.t[i + 1] == ev.t):
+            return False
+        post = np.asarray(ev.x_post, float)
+        return post.size <= self.x.shape[1] and np.array_equal(self.x[i, : post.size], post)
 
     # ------------------------------------------------------------------ resampling & export
     def resample(self, fps: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
