@@ -149,3 +149,18 @@ def test_the_compass_gaits_box_share_counts_the_states_goswamis_equations_return
         count += _goswami_returns(x, x_fix)
     assert b.section_coordinates == list(half) and 0 < count < 24
     assert b.size["inside"] == count
+
+
+def test_the_command_line_takes_the_boxs_half_width_per_section_coordinate(capsys):
+    args = ["robustness", "compass-gait", "--param", "slope", "--json", "--samples", "8",
+            "--direction", "stance_dot=-1", "--box", "stance=0.02, stance_dot=0.08,swing_dot=0.5"]
+    assert main(args) == 0
+    d = json.loads(capsys.readouterr().out)
+    x = find_fixed_point(load_model("compass-gait", derivatives=True)).fixed_point
+    box = d["basin"]["size"]["box"]
+    assert list(box) == ["stance", "stance_dot", "swing_dot"]
+    for name, i, h in (("stance", 0, 0.02), ("stance_dot", 2, 0.08), ("swing_dot", 3, 0.5)):
+        assert box[name] == pytest.approx([x[i] - h, x[i] + h], abs=1e-9)
+    for bad in ("stance=0.02,swing=0.1", "stance=0.02", "stance=x", "wide"):
+        assert main([*args[:-1], bad]) == 2
+        assert len(capsys.readouterr().err.strip().splitlines()) == 1

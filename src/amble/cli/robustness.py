@@ -36,23 +36,33 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
                    help="farthest distance sought along a direction, in state units (default 1)")
     b.add_argument("--samples", type=int, default=1000,
                    help="random states of a box around the gait walked for the basin's share (default 1000, 0: none)")
-    b.add_argument("--box", type=float, default=None, metavar="H",
-                   help="half-width of that box along every section coordinate (default: the distances found)")
+    b.add_argument("--box", default=None, metavar="H|NAME=H[,NAME=H...]",
+                   help="half-width of that box: one for every section coordinate, or one per section "
+                        "coordinate by name (default: the distances found)")
     b.add_argument("--seed", type=int, default=0, help="seed of the box's samples (default 0)")
     b.add_argument("--threads", type=int, default=1, help="threads the walks share (default 1)")
     b.add_argument("--no-basin", action="store_true", help="the gait sensitivity norm only")
     r.set_defaults(func=cmd_robustness)
 
 
-def parse_direction(text: str) -> dict[str, float]:
+def parse_direction(text: str, option: str = "--direction") -> dict[str, float]:
     """``NAME=V[,NAME=V...]`` → a direction (components read with ``float``, never evaluated)."""
     out: dict[str, float] = {}
     for item in text.split(","):
         name, eq, val = item.partition("=")
         if not eq or not name.strip():
-            raise UsageError(f"--direction expects NAME=VALUE[,NAME=VALUE...], got {text!r}")
-        out[name.strip()] = _float(val.strip(), f"--direction {name.strip()}")
+            raise UsageError(f"{option} expects NAME=VALUE[,NAME=VALUE...], got {text!r}")
+        out[name.strip()] = _float(val.strip(), f"{option} {name.strip()}")
     return out
+
+
+def parse_box(text: str | None) -> float | dict[str, float] | None:
+    """``H`` (every section coordinate) or ``NAME=H[,NAME=H...]`` (each by name)."""
+    if text is None:
+        return None
+    if "=" in text:
+        return parse_direction(text, "--box")
+    return _float(text.strip(), "--box")
 
 
 def cmd_robustness(args: argparse.Namespace) -> dict[str, Any]:
@@ -61,6 +71,7 @@ def cmd_robustness(args: argparse.Namespace) -> dict[str, Any]:
     from ..analysis.robustness import gait_sensitivity
 
     dirs = None if args.direction is None else [parse_direction(t) for t in args.direction]
+    box = parse_box(args.box)
     system = load_model(args.model, derivatives=True)
     params = parse_sets(args.set)
     guess = parse_start(system, args.guess, params, "--guess")
@@ -68,7 +79,7 @@ def cmd_robustness(args: argparse.Namespace) -> dict[str, Any]:
     g = gait_sensitivity(lc, args.param)
     out = g.to_json()
     b = None if args.no_basin else basin_measures(
-        lc, dirs, steps=args.steps, criterion=args.criterion, reach=args.reach, samples=args.samples, box=args.box,
+        lc, dirs, steps=args.steps, criterion=args.criterion, reach=args.reach, samples=args.samples, box=box,
         seed=args.seed, threads=args.threads)
     if b is not None:
         out["basin"] = b.to_json()
