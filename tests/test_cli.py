@@ -124,7 +124,7 @@ def test_limit_cycle_tol_bounds_the_residual(capsys):
 
 def test_a_period_beyond_the_return_maps_bound_is_refused_before_any_work(capsys, monkeypatch):
     # one bound for the command line and the return map: refused before the model is loaded
-    cli = sys.modules["amble.cli.main"]
+    cli = sys.modules["amble.cli.limit_cycle"]
 
     def no_load(*a, **k):
         raise AssertionError("the model was loaded")

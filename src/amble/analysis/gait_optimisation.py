@@ -30,7 +30,6 @@ with exact sparse first and second derivatives; IPOPT solves it.
 
 from __future__ import annotations
 
-import time
 import weakref
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -40,30 +39,19 @@ import sympy as sp
 
 from ..backend.cache import fingerprint
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
-from ..errors import ParameterError, SolverError, StateError
+from ..errors import ParameterError
 from ..modelling.hybrid import HybridSystem
-from ..modelling.text import expr_of
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
-from .gait_result import Gait, bezier_fit, constraint_report
+from .gait_ipopt import _solve_nlp
+from .gait_layout import _bound_groups, _bounds, _gait
+from .gait_options import _check_options, _check_stability_option, _expression, _integrand, _parameters
+from .gait_result import Gait
 from .gait_stability import momentum_function, restricted_multiplier
 from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
-from .solver_io import Interrupts, StdoutToStderr
 
 OBJECTIVES = ("effort", "cot")
-
-_FAILURES = {
-    "Infeasible_Problem_Detected": "the constraints are infeasible",
-    "Restoration_Failed": "restoration failed (no feasible point near the iterate)",
-    "Maximum_Iterations_Exceeded": "iteration limit reached",
-    "Maximum_CpuTime_Exceeded": "time limit reached",
-    "Search_Direction_Becomes_Too_Small": "search direction too small",
-    "Error_In_Step_Computation": "error in step computation",
-    "Invalid_Number_Detected": "a non-finite number in the model's functions",
-    "Diverging_Iterates": "diverging iterates",
-}
-
 
 def optimize_gait(
     system: HybridSystem,
@@ -317,18 +305,6 @@ def _stability_report(sigma: Any, gait: Gait, P: np.ndarray, n: int, max_multipl
     return {"restricted_multiplier": value, "max_multiplier": max_multiplier}
 
 
-def _check_stability_option(max_multiplier: float | None, hzd: bool, steps: int) -> None:
-    if max_multiplier is None:
-        return
-    if not (isinstance(max_multiplier, (int, float)) and np.isfinite(max_multiplier) and 0 < max_multiplier < 1):
-        raise ParameterError(f"max_multiplier must be a number in (0, 1), got {max_multiplier!r}")
-    if not hzd:
-        raise ParameterError("max_multiplier bounds the restricted Poincaré map of the hybrid zero dynamics: it "
-                             "needs hzd=True (virtual constraints)")
-    if steps != 1:
-        raise ParameterError(f"max_multiplier is for one-step gaits (steps=1), got steps={steps}")
-
-
 def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multiplier: float | None,
               wanted: bool) -> Any:
     """The zero dynamics' momentum σ (:func:`~amble.analysis.gait_stability.momentum_function`)
@@ -365,18 +341,6 @@ def _step_functions(system: HybridSystem, integrand: sp.Expr | None, phase: sp.E
     return fns
 
 
-def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:
-    values = dict(system.parameters)
-    for k, v in (params or {}).items():
-        if k not in values:
-            raise ParameterError(f"unknown parameter {k!r} (parameters: {', '.join(values)})")
-        if not np.isfinite(v):
-            raise ParameterError(f"parameter {k!r} must be finite, got {v!r}")
-        values[k] = float(v)
-    system.check_parameters(values)
-    return values
-
-
 def _running_cost(ca: Any, fns: StepFunctions, objective: Any, U: Any, PW: Any, Q: Any, V: Any, taus: Any,
                   Pj: Any) -> tuple[Any, float]:
     """The objective's integrand at the ``K`` points (a 1 × K row) and its scale: ``effort`` Σu²,
@@ -387,132 +351,5 @@ def _running_cost(ca: Any, fns: StepFunctions, objective: Any, U: Any, PW: Any, 
     if isinstance(objective, str) and objective == "cot":
         return (ca.sum1(PW) if nu else ca.MX.zeros(1, K)), 1.0 / float(fns.weight(Pj))
     return fns.integrand.map(K)(Q, V, U, taus, Pj), 1.0
-
-
-def _solve_nlp(ca: Any, nlp: dict[str, Any], opts: dict[str, Any], progress: bool, tol: float,
-               groups: list[tuple[str, Any, float, float]], bound_groups: list[tuple[str, int, int]],
-               **problem: Any) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any], float]:
-    """IPOPT on ``nlp`` from ``problem`` (start and bounds): the solution, IPOPT's statistics, the
-    constraint report and the seconds it took; a failure is a :class:`SolverError` naming the reason
-    and the most violated constraint, Ctrl-C a ``KeyboardInterrupt``."""
-    solver = ca.nlpsol("gait", "ipopt", nlp, opts)
-    t0 = time.perf_counter()
-    with StdoutToStderr(progress), Interrupts() as interrupted:
-        sol = solver(**problem)
-    if interrupted:  # CasADi turns Ctrl-C into a solver failure: it is the user's interrupt
-        raise KeyboardInterrupt
-    elapsed = time.perf_counter() - t0
-    stats = solver.stats()
-    gval = np.asarray(sol["g"]).ravel()
-    report = constraint_report(groups, gval, problem["lbg"], problem["ubg"], np.asarray(sol["x"]).ravel(),
-                               problem["lbx"], problem["ubx"], bound_groups)
-    status = stats.get("return_status", "unknown")
-    if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
-        worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
-        reason = _FAILURES.get(status, status.replace("_", " ").lower())
-        binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"
-                   if worst[1]["max_violation"] > tol else "at the starting point" if not stats.get("iter_count")
-                   else "every constraint holds at the last iterate (the optimality conditions do not)")
-        raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
-                          f"{binding}")
-    return sol, stats, report, elapsed
-
-
-def _check_options(system: HybridSystem, speed: float | None, step_length: float | None, mu: float | None,
-                   step_time: float | None, clearance: float | None, nodes: Any, hzd: bool | None,
-                   bezier_degree: int | None, max_iter: Any, steps: Any) -> tuple[bool, int]:
-    """:class:`ParameterError` for an option out of its domain, before any work; returns ``hzd``
-    and ``bezier_degree`` with their defaults filled in (the model's virtual constraints, if any)."""
-    if speed is not None and step_length is not None:
-        raise ParameterError("give speed or step_length, not both")
-    for name, v in (("speed", speed), ("step_length", step_length), ("mu", mu), ("step_time", step_time)):
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ParameterError(f"{name} must be a finite number > 0, got {v!r}")
-    if clearance is not None and not (np.isfinite(clearance) and clearance >= 0):
-        raise ParameterError(f"clearance must be a finite number ≥ 0, got {clearance!r}")
-    sizes = [nodes] if isinstance(nodes, int) else list(nodes)
-    if not sizes or not all(isinstance(k, int) and 2 <= k <= 2000 for k in sizes):
-        raise ParameterError(f"nodes must be an integer in [2, 2000] (or a list of them), got {nodes!r}")
-    vc = getattr(system.modes[system.mode_names[0]], "virtual", None)
-    if hzd is None:
-        hzd = vc is not None
-    if bezier_degree is None:
-        bezier_degree = vc.degree if vc is not None else 5
-    if not (isinstance(bezier_degree, int) and 1 <= bezier_degree <= 20):
-        raise ParameterError(f"bezier_degree must be an integer in [1, 20], got {bezier_degree!r}")
-    if not (isinstance(max_iter, int) and max_iter >= 1):
-        raise ParameterError(f"max_iter must be an integer ≥ 1, got {max_iter!r}")
-    if not (isinstance(steps, int) and 1 <= steps <= 8):
-        raise ParameterError(f"steps must be an integer in [1, 8], got {steps!r}")
-    return bool(hzd), bezier_degree
-
-
-def _integrand(model: Any, objective: Any) -> sp.Expr:
-    return _expression(model, objective, "objective", [*model.qd, *(getattr(model, "inputs", []) or [])],
-                       "objectives: effort, cot, or an expression in ")
-
-
-def _expression(model: Any, text: Any, what: str, extra: Sequence[sp.Symbol] = (), hint: str = "") -> sp.Expr:
-    """A user expression (text or sympy) in the coordinates, parameters and ``extra`` symbols."""
-    known = {str(s): s for s in [*model.q, *model.params, *extra]}
-    expr = expr_of(text, known, what=what)  # text is read, never evaluated
-    bad = sorted(str(s) for s in expr.free_symbols if str(s) not in known or known[str(s)] != s)
-    if bad:
-        raise ParameterError(f"{what} {text!s} uses {', '.join(bad)}: not among the allowed names "
-                             f"({hint}{', '.join(known)})")
-    return expr
-
-
-def _bounds(model: Any, fns: StepFunctions, bounds: Mapping | None, N: int, t_guess: float
-            ) -> tuple[np.ndarray, np.ndarray]:
-    n, d, K = fns.n, fns.dims, 2 * N + 1
-    lo_x, hi_x = np.full(2 * n, -np.inf), np.full(2 * n, np.inf)
-    limits = dict(getattr(model.tree, "limits", {}) or {}) if getattr(model, "tree", None) is not None else {}
-    limits.update(bounds or {})
-    for name, (lo, hi) in limits.items():
-        if name not in fns.state_names:
-            raise StateError(f"bound on {name!r}: not a state variable ({', '.join(fns.state_names)})")
-        i = fns.state_names.index(name)
-        lo_x[i] = -np.inf if lo is None else lo
-        hi_x[i] = np.inf if hi is None else hi
-    lim = getattr(model, "input_limits", {}) or {}
-    hi_u = np.array([np.inf if lim.get(k) is None else float(lim[k]) for k in fns.input_names])
-    T_lo, T_hi = 0.02 * t_guess, 20.0 * t_guess
-    lbw = np.concatenate([np.tile(lo_x, K), np.full(n * K, -np.inf), np.tile(-hi_u, K), [T_lo],
-                          np.full(n + 2 * d, -np.inf)])
-    ubw = np.concatenate([np.tile(hi_x, K), np.full(n * K, np.inf), np.tile(hi_u, K), [T_hi],
-                          np.full(n + 2 * d, np.inf)])
-    return lbw, ubw
-
-
-def _bound_groups(fns: StepFunctions, N: int) -> list[tuple[str, int, int]]:
-    """Where each kind of bound sits in the vector of unknowns: (name, start, stop)."""
-    n, nu, K = fns.n, fns.nu, 2 * N + 1
-    s = 2 * n * K + n * K
-    return [("joint_limits", 0, 2 * n * K), ("actuator_limits", s, s + nu * K), ("step_time", s + nu * K,
-                                                                                   s + nu * K + 1)]
-
-
-def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: np.ndarray, N: int,
-          objective: Any, value: float, report: dict, solver: dict, degree: int, hzd: bool = False) -> Gait:
-    n, nu, K = fns.n, fns.nu, 2 * N + 1
-    X = w[: 2 * n * K].reshape(K, 2 * n)
-    A = w[2 * n * K: 3 * n * K].reshape(K, n)
-    U = w[3 * n * K: (3 * n + nu) * K].reshape(K, nu)
-    T = float(w[(3 * n + nu) * K])
-    base = (3 * n + nu) * K + 1
-    qe, impulse = w[base: base + n + fns.dims], w[base + n + fns.dims: base + n + 2 * fns.dims]
-    # an HZD gait's coefficients are the last unknowns (column-major nu × (M+1)): exported as
-    # optimised, not refitted, so the controller holds exactly the polynomial of the collocation
-    alpha = w[len(w) - nu * (degree + 1):].reshape(degree + 1, nu).T if hzd and nu else None
-    P = np.array([pvals[k] for k in fns.param_names])
-    L = float(fns.distance(X[-1, :n], P))
-    forces = np.array([np.asarray(fns.contact(x[:n], x[n:], a, P), float).ravel() for x, a in zip(X, A)])
-    return Gait(system=system.name, state_names=list(fns.state_names), input_names=list(fns.input_names),
-                params=pvals, objective_name=str(objective), objective=value, fixed_point=X[0].copy(),
-                step_time=T, step_length=L, speed=L / T, times=np.linspace(0.0, T, K), states=X,
-                accelerations=A, inputs=U, pre_impact_state=X[-1].copy(), impulse=np.asarray(impulse),
-                extended_velocity=np.asarray(qe), contact_forces=forces,
-                constraints=report, solver=solver, bezier=bezier_fit(model, fns, X, degree, P, alpha))
 
 

@@ -17,34 +17,28 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
-from ..analysis.defaults import BASIN_STEPS, FIXED_POINT_TOL, RESIDUAL_TOL, SWEEP_TOL
+from ..analysis.defaults import BASIN_STEPS, RESIDUAL_TOL, SWEEP_TOL
 from ..errors import AmbleError, SolverError
-from ..models import LIMIT_ACTIONS
-from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
-from .args import (
-    UsageError,
-    _Parser,
-    check_tol,
-    load_model,
-    parse_sets,
-    parse_start,
-    robot_options,
-    writable_path,
-)
+from .args import _Parser
 from .cache import add_parser as add_cache_parser
 from .doublings import EXAMPLE as DOUBLINGS_EXAMPLE
 from .doublings import add_parser as add_doublings_parser
 from .gait import add_parser as add_gait_parser
 from .gaits import EXAMPLE as GAITS_EXAMPLE
 from .gaits import add_parser as add_gaits_parser
+from .limit_cycle import EXAMPLE as LIMIT_CYCLE_EXAMPLE
+from .limit_cycle import add_parser as add_limit_cycle_parser
+from .limit_cycle import cmd_limit_cycle as cmd_limit_cycle  # re-exported: the command's old home
 from .mfpt import EXAMPLE as MFPT_EXAMPLE
 from .mfpt import add_parser as add_mfpt_parser
 from .mujoco import EXAMPLE as MUJOCO_EXAMPLE
 from .mujoco import add_parser as add_mujoco_parser
-from .output import gait_check_lines, write_output
 from .prefetch import prefetch_plotting
 from .robustness import EXAMPLE as ROBUSTNESS_EXAMPLE
 from .robustness import add_parser as add_robustness_parser
+from .simulate import EXAMPLE as SIMULATE_EXAMPLE
+from .simulate import add_parser as add_simulate_parser
+from .simulate import cmd_simulate as cmd_simulate  # re-exported: the command's old home
 
 MODEL_HELP = ("a library model (see 'amble models'), a model file path/to/file.py[:callable]: the callable, "
               "else the file's build(), else the one HybridSystem it defines, or a robot file path/to/robot.urdf "
@@ -78,192 +72,6 @@ def cmd_models(args: argparse.Namespace) -> dict[str, Any]:
     return {"models": rows}
 
 
-def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
-    from ..simulation.simulate import simulate
-
-    out_p = writable_path(args.out, (".csv", ".parquet", ".npz"), "--out")
-    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
-    series = _series(args.series, anim_p)
-    if anim_p:  # an MP4 without ffmpeg is refused before any work
-        from ..viz.movie import check_writer
-
-        check_writer(anim_p)
-    most = Options().max_events  # a run ends at this many events whatever --steps asks
-    if args.steps is not None and not 1 <= args.steps <= most:
-        raise UsageError(f"--steps must be at least 1 and at most {most}, got {args.steps}")
-    if args.time is not None and not args.time > 0:
-        raise UsageError(f"--time must be positive, got {args.time}")
-    drawn = bool(plot_p or anim_p)
-    derivatives = args.start == "fixed-point" or NEEDS_JACOBIAN[args.method]
-    s = load_model(args.model, compiled=not drawn, derivatives=derivatives, limits=args.limits,
-                   **robot_options(args))
-    if out_p and (any(m.inputs for m in s.modes.values()) or getattr(s, "hip", None) is not None):
-        s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
-    params = parse_sets(args.set)
-    x0 = parse_start(s, args.start, params, "--start")
-    t_end, steps = args.time, args.steps
-    if steps is None and t_end is None:  # 20 footfalls; a system that makes none runs for a second
-        walks = any(tr.step for tr in s.transitions)
-        steps, t_end = (20, None) if walks else (None, 1.0)
-    # samples are recorded only for an output that shows them: a summary needs the events alone
-    tr = simulate(s, x0, params=params, steps=steps, t_end=t_end, rtol=args.rtol, atol=args.atol,
-                  sample_dt=1.0 / 200, samples=bool(out_p or plot_p or anim_p), method=args.method)
-    summary = tr.summary()
-    if args.limits != "ignore":
-        summary["limit"] = _limit_reached(tr)
-    if out_p:
-        from ..analysis.trajectory_physics import physics_columns
-
-        # the file holds the physics as well as the states: ground reaction, friction ratio, work
-        extra = physics_columns(tr)
-        write_output(out_p, lambda part: tr.save(part, extra=extra), "--out")
-        summary["out"] = str(out_p)
-    if plot_p:
-        from ..viz.plot import plot_trajectory
-
-        write_output(plot_p, lambda part: plot_trajectory(tr, part), "--plot")
-        summary["plot"] = str(plot_p)
-    if anim_p:
-        _animate(tr, anim_p, series)
-        summary["animation"] = str(anim_p)
-    if not args.json:
-        print(f"{args.model}: {tr.status} — {tr.message}")
-        hit = summary.get("limit")
-        if hit is not None:
-            print(f"joint limit: {hit['coordinate']} reached its {hit['bound']} limit at t = {hit['t']:.12g} s "
-                  f"({hit['coordinate']} = {hit['position']:.12g})")
-        post = summary["final_post_impact_state"]
-        if post is not None:
-            print("post-impact state: " + ", ".join(f"{n}={v:.6g}" for n, v in zip(summary["state_names"], post)))
-        for k in ("out", "plot", "animation"):
-            if k in summary:
-                print(f"wrote {summary[k]}")
-    return summary
-
-
-def _limit_reached(tr: Any) -> dict[str, Any] | None:
-    """The joint limit a run ended at (``--limits stop``): the coordinate, the bound (``lower``
-    or ``upper``), the event time ``t`` (s) and the coordinate's value there; ``None`` if the
-    run ended otherwise."""
-    from ..modelling.limits import STATUS, limit_of
-
-    if tr.status != STATUS or not len(tr.events):
-        return None
-    event = tr.events[-1]
-    hit = limit_of(event.name)
-    if hit is None:
-        return None
-    coordinate, bound = hit
-    position = float(event.x_pre[tr.state_names(event.source).index(coordinate)])
-    return {"coordinate": coordinate, "bound": bound, "t": float(event.t), "position": position,
-            "transition": event.name}
-
-
-def _series(values: list[str] | None, anim_p: Any) -> Any:
-    """The ``series`` of the viewer from ``--series`` options: ``None`` (the default panels),
-    ``[]`` for ``none``, a list of names (one panel per unit), or panel title → names when every
-    option reads ``TITLE=NAME,...``."""
-    if not values:
-        return None
-    if anim_p is None or anim_p.suffix.lower() != ".html":
-        raise UsageError("--series needs --animate FILE.html (the viewer's time-series plot)")
-    if [v.strip().lower() for v in values] == ["none"]:
-        return []
-    panels: dict[str, list[str]] = {}
-    names: list[str] = []
-    for v in values:
-        title, sep, rest = v.partition("=") if "=" in v else ("", "", v)
-        parts = [n.strip() for n in rest.split(",") if n.strip()]
-        if not parts or (sep and not title.strip()):
-            raise UsageError(f"--series expects 'NAME,NAME,...' or 'TITLE=NAME,...', got {v!r}")
-        if sep:
-            panels.setdefault(title.strip(), []).extend(parts)
-        names += parts
-    if 0 < sum("=" in v for v in values) < len(values):
-        raise UsageError("--series: give every panel a title (TITLE=NAME,...) or none")
-    return panels or names
-
-
-def _animate(tr: Any, path: Any, series: Any = None) -> None:
-    """Write the animation of ``tr``: a GIF or MP4 is written atomically by the movie writer itself
-    (its messages name the file), an HTML page through a part file."""
-    from ..viz.animate import animate
-
-    if path.suffix.lower() in (".gif", ".mp4"):
-        animate(tr, path)
-    else:
-        write_output(path, lambda part: animate(tr, part, series=series), "--animate")
-
-
-def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
-    from ..analysis.poincare import find_fixed_point
-
-    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
-    series = _series(args.series, anim_p)
-    if anim_p:  # an MP4 without ffmpeg is refused before any work
-        from ..viz.movie import check_writer
-
-        check_writer(anim_p)
-    # the return map's own bound (a period-k search walks k steps per Newton iteration), checked
-    # before the model is loaded
-    from ..analysis.return_map import MAX_PERIOD
-
-    if not 1 <= args.period <= MAX_PERIOD:
-        raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
-    # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
-    s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True, **robot_options(args))
-    params = parse_sets(args.set)
-    guess = parse_start(s, args.guess, params, "--guess") if args.guess else None
-    lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol,
-                          tol=check_tol(args.tol))
-    out = lc.to_json()
-    if any(getattr(m, "inputs", None) for m in s.modes.values()) and getattr(s, "hip", None) is not None:
-        from ..analysis.gait_check import check_gait
-
-        lc.hybrid_system = s.symbolic()  # the checks read the symbolic model (contact forces, the control law)
-
-        # an actuated gait: is it physically feasible (ground reaction, friction, clearance, limits)?
-        gait = lc.trajectory(steps=lc.period)
-        out["checks"] = check_gait(gait).to_json()
-        out["work_per_step"] = {k: float(v.sum()) for k, v in gait.work_per_step().items()}  # J per period
-        out["cost_of_transport"] = gait.cost_of_transport()
-    if plot_p or anim_p:
-        from ..simulation.simulate import simulate
-
-        tr = simulate(s, lc.fixed_point, params=params, steps=max(args.period, 2) if plot_p and not anim_p else 12,
-                      rtol=args.rtol, atol=args.atol, sample_dt=1.0 / 200)
-        if plot_p:
-            from ..viz.plot import plot_limit_cycle
-
-            write_output(plot_p, lambda part: plot_limit_cycle(tr, part, cycle=lc), "--plot")
-            out["plot"] = str(plot_p)
-        if anim_p:
-            _animate(tr, anim_p, series)
-            out["animation"] = str(anim_p)
-    if not args.json:
-        unit = s.time_unit
-        if lc.requested_period and lc.requested_period != lc.period:
-            print(f"{args.model}: the period-{lc.requested_period} search converged to a period-{lc.period} gait")
-        print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
-              f"{'mean ' if lc.period > 1 else ''}step time {lc.step_time:.6g} {unit} "
-              f"(residual {lc.residual:.1e}, {lc.iterations} iterations)")
-        if lc.period == 1:
-            print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
-        else:  # every point of the orbit and the time of every step: the mean alone hides the alternation
-            for i, (point, dt) in enumerate(zip(lc.orbit, lc.step_times), 1):
-                print(f"point {i}/{lc.period} (step time {dt:.6g} {unit}): "
-                      + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, point)))
-        print("multipliers: " + ", ".join(f"{m.real:+.5f}{m.imag:+.5f}i (|{abs(m):.5f}|)" for m in lc.multipliers))
-        if "checks" in out:
-            print("\n".join(gait_check_lines(out["checks"], si=unit == "s")))
-        for k in ("plot", "animation"):
-            if k in out:
-                print(f"wrote {out[k]}")
-    return out
-
-
 def cmd_equations(args: argparse.Namespace) -> dict[str, Any]:
     from .equations import cmd_equations as run  # SymPy's printers: only for this command
 
@@ -278,14 +86,11 @@ def cmd_sweep(args: argparse.Namespace) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------- parser
-SERIES_HELP = ("with --animate FILE.html: the time series plotted under the 3D view, NAME,NAME,... (names "
-               "of one unit share a panel) or TITLE=NAME,... (one titled panel each; repeatable); names: "
-               "state variables and 'energy'; 'none' for no plot (default: the coordinates and the energy)")
 EXAMPLES = {
     "models": "amble models --json",
     "equations": "amble equations compass-gait --latex",
-    "simulate": "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html",
-    "limit-cycle": "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png",
+    "simulate": SIMULATE_EXAMPLE,
+    "limit-cycle": LIMIT_CYCLE_EXAMPLE,
     "sweep": "amble sweep compass-gait --param slope=0.01:0.08:50 --out sweep.csv --plot branch.png",
     "optimize-gait": "amble optimize-gait compass-gait --set slope=0.0524 --out gait.json",
     "gaits": GAITS_EXAMPLE,
@@ -370,37 +175,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     e.add_argument("--standalone", action="store_true",
                    help="a whole LaTeX document (implies --latex; with --json: the field 'document')")
     e.set_defaults(func=cmd_equations)
-    s = add("simulate", "simulate a model for N steps or T seconds")
-    model_args(s, Options().rtol)
-    g = s.add_mutually_exclusive_group()
-    g.add_argument("--steps", type=int, help="number of footfalls (default 20)")
-    g.add_argument("--time", type=float, help="end time in seconds (default for a system without footfalls: 1)")
-    s.add_argument("--start", help="'fixed-point' or 'x0=V1,V2,...' (full state, state_names order)")
-    s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
-    s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
-    s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
-    s.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
-    s.add_argument("--limits", choices=LIMIT_ACTIONS, default="ignore",
-                   help="what a joint reaching a limit of its range (a URDF joint limit, an MJCF range) does: "
-                        "ignore (default: it passes, as if unlimited) or stop (the run ends there, status "
-                        "joint_limit, reporting the coordinate, the bound and the time; in --json the field 'limit'), "
-                        "e.g. amble simulate tests/data/pendulum.urdf --fixed-base --limits stop")
-    s.add_argument("--method", choices=METHODS, default="dop853",
-                   help="integrator: dop853 (explicit, default), radau (implicit, for stiff models) or "
-                        "tsit5 (explicit, 5th order)")
-    s.set_defaults(func=cmd_simulate, plots_in_process=True)
-    lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
-    model_args(lc, FIXED_POINT_TOL)
-    lc.add_argument("--period", type=int, default=1,
-                    help="k for a period-k gait (default 1); all k points and step times are reported")
-    lc.add_argument("--tol", type=float, default=RESIDUAL_TOL,
-                    help=f"fixed-point tolerance: the largest residual |P(x) - x| of the gait (default "
-                         f"{RESIDUAL_TOL:g}, so that the fixed point is within 1e-10 of the map's)")
-    lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
-    lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
-    lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
-    lc.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
-    lc.set_defaults(func=cmd_limit_cycle, plots_in_process=True)
+    add_simulate_parser(add, model_args)
+    add_limit_cycle_parser(add, model_args)
     sw = add("sweep", "parameter sweep (fixed points, continuation, bifurcation diagram) or basin of attraction, "
                       "on local worker processes or Dask")
     model_args(sw, None)
