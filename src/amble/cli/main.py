@@ -128,7 +128,7 @@ class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
 
 class _Unused:
     """Stands in for the parser of a command that is not being run: every call is accepted and
-    does nothing (building all seven parsers costs more than a warm limit cycle's search)."""
+    does nothing (building every command's parser costs more than a warm limit cycle's search)."""
 
     def __getattr__(self, name: str) -> Any:
         return lambda *a, **k: self
