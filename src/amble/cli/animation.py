@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .args import UsageError
+from .args import UsageError, writable_path
 from .output import write_output
 
 SERIES_HELP = ("with --animate FILE.html: the time series plotted under the 3D view, NAME,NAME,... (names "
@@ -37,6 +37,19 @@ def parse_series(values: list[str] | None, anim_p: Any) -> Any:
         raise UsageError("--series: give every panel a title (TITLE=NAME,...) or none")
     return panels or names
 
+
+def drawing_outputs(args: Any) -> tuple[Any, Any, Any]:
+    """``--plot``, ``--animate`` and ``--series`` checked before any work: the two paths (or
+    ``None``) and the viewer's series; a movie format without its writer (MP4 without ffmpeg) is
+    refused here, not after the run."""
+    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
+    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
+    series = parse_series(args.series, anim_p)
+    if anim_p:
+        from ..viz.movie import check_writer
+
+        check_writer(anim_p)
+    return plot_p, anim_p, series
 
 
 def write_animation(tr: Any, path: Any, series: Any = None) -> None:

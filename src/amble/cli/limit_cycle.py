@@ -9,8 +9,8 @@ from collections.abc import Callable
 from typing import Any
 
 from ..analysis.defaults import FIXED_POINT_TOL, RESIDUAL_TOL
-from .animation import SERIES_HELP, parse_series, write_animation
-from .args import UsageError, check_tol, load_model, parse_sets, parse_start, robot_options, writable_path
+from .animation import SERIES_HELP, drawing_outputs, write_animation
+from .args import UsageError, check_tol, load_model, parse_sets, parse_start, robot_options
 from .output import gait_check_lines, write_output
 
 EXAMPLE = "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png"
@@ -35,13 +35,7 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
 def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     from ..analysis.poincare import find_fixed_point
 
-    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
-    series = parse_series(args.series, anim_p)
-    if anim_p:  # an MP4 without ffmpeg is refused before any work
-        from ..viz.movie import check_writer
-
-        check_writer(anim_p)
+    plot_p, anim_p, series = drawing_outputs(args)
     # the return map's own bound (a period-k search walks k steps per Newton iteration), checked
     # before the model is loaded
     from ..analysis.return_map import MAX_PERIOD

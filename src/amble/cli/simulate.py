@@ -9,7 +9,7 @@ from typing import Any
 
 from ..models import LIMIT_ACTIONS
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
-from .animation import SERIES_HELP, parse_series, write_animation
+from .animation import SERIES_HELP, drawing_outputs, write_animation
 from .args import UsageError, load_model, parse_sets, parse_start, robot_options, writable_path
 from .output import write_output
 
@@ -43,13 +43,7 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
     from ..simulation.simulate import simulate
 
     out_p = writable_path(args.out, (".csv", ".parquet", ".npz"), "--out")
-    plot_p = writable_path(args.plot, (".png", ".svg", ".pdf"), "--plot")
-    anim_p = writable_path(args.animate, (".html", ".gif", ".mp4"), "--animate")
-    series = parse_series(args.series, anim_p)
-    if anim_p:  # an MP4 without ffmpeg is refused before any work
-        from ..viz.movie import check_writer
-
-        check_writer(anim_p)
+    plot_p, anim_p, series = drawing_outputs(args)
     most = Options().max_events  # a run ends at this many events whatever --steps asks
     if args.steps is not None and not 1 <= args.steps <= most:
         raise UsageError(f"--steps must be at least 1 and at most {most}, got {args.steps}")
