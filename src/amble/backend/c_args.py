@@ -18,6 +18,8 @@ from ..errors import ModelError, StateError
 
 __all__ = ["address"]
 
+_ndarray = np.ndarray
+
 _dptr = ctypes.POINTER(ctypes.c_double)
 _iptr = ctypes.POINTER(ctypes.c_int)
 _i64ptr = ctypes.POINTER(ctypes.c_int64)
@@ -134,3 +136,52 @@ def _rows(t: Any, modes: Any, x: Any, nx_max: int, n_modes: int) -> tuple[np.nda
     if x.shape[1] < nx_max:
         x = np.hstack([x, np.full((x.shape[0], nx_max - x.shape[1]), np.nan)])
     return t, modes, np.ascontiguousarray(x)
+
+
+class _ModeCall:
+    """What the per-state calls of one mode need, worked out once (see :func:`_call_tables`)."""
+
+    __slots__ = ("shape", "rhs", "guards", "n_guards", "dynamics", "nq", "dynamics_rows", "h_at", "g_at",
+                 "rhs_jac", "rhs_jac_rows", "f_at", "f", "jx", "jp", "surfaces", "surface_rows", "gx", "gp")
+
+
+class _TransitionCall:
+    """What the per-state calls of one transition need, worked out once (see :func:`_call_tables`)."""
+
+    __slots__ = ("shape", "post", "target_at", "jac", "jac_rows", "dx", "dp", "dt")
+
+
+def _call_tables(nx: tuple[int, ...], n_guards: tuple[int, ...], n_surfaces: tuple[int, ...],
+                 tr_nx: tuple[tuple[int, int], ...], nx_max: int, sc: int, npar: int, guard_len: int, n_switches: int
+                 ) -> tuple[tuple[_ModeCall, ...], tuple[_TransitionCall, ...]]:
+    """Per mode and per transition: the state's shape, the C array types of the outputs (a fresh
+    zeroed one per call; C writes into it and the results are views of it), the byte offsets of
+    outputs after the first, and the index tuples of the views returned. ``n_guards``: each
+    mode's guards; ``n_surfaces``: those plus its switching surfaces; ``tr_nx`` is (source, target) state length
+    per transition; ``sc`` is the columns of a sensitivity row (state, then parameters)."""
+    c = ctypes.c_double
+    par = slice(nx_max, nx_max + npar)  # the parameter columns of a sensitivity row
+    modes = []
+    for n, n_g, rows in zip(nx, n_guards, n_surfaces):
+        m = _ModeCall()
+        m.shape, m.rhs, m.guards, m.n_guards = (n,), c * n, c * guard_len, n_g
+        nq = m.nq = n // 2
+        m.dynamics, m.dynamics_rows = c * ((nq + 2) * nq), (nq + 2, nq)  # M (nq rows), h, Γ
+        m.h_at, m.g_at = 8 * nq * nq, 8 * (nq * nq + nq)
+        m.rhs_jac, m.rhs_jac_rows, m.f_at = c * ((n + 1) * sc), (n + 1, sc), 8 * n * sc  # J rows, then f
+        m.f, m.jx, m.jp = (n, slice(n)), (slice(n), slice(n)), (slice(n), par)
+        m.surfaces, m.surface_rows = c * ((guard_len + n_switches) * sc), (guard_len + n_switches, sc)
+        m.gx, m.gp = (slice(rows), slice(n)), (slice(rows), par)
+        modes.append(m)
+
+    class Post(ctypes.Structure):
+        _fields_ = [("x", c * nx_max), ("target", ctypes.c_int)]
+
+    trs = []
+    for n, nd in tr_nx:
+        tr = _TransitionCall()
+        tr.shape, tr.post, tr.target_at = (n,), Post, Post.target.offset
+        tr.jac, tr.jac_rows = c * (nx_max * (sc + 1)), (nx_max, sc + 1)
+        tr.dx, tr.dp, tr.dt = (slice(nd), slice(n)), (slice(nd), par), (slice(nd), sc)
+        trs.append(tr)
+    return tuple(modes), tuple(trs)

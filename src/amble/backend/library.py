@@ -25,13 +25,15 @@ from .c_args import (
     _NO_PARAMS_ADDRESS,
     _addressof,
     _arg,
+    _bytes_of,
+    _call_tables,
     _dptr,
     _frombuffer,
     _i64ptr,
     _iptr,
     _lookup,
     _matrix,
-    _out,
+    _ndarray,
     _p,
     _rows,
     _vec,
@@ -124,6 +126,10 @@ class Kernels:
         self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
         self._c_dynamics, self._c_rhs_jac_all = lib.amble_dynamics, lib.amble_rhs_jac_all
         self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
+        self._modes = tuple(modes)
+        self._per_mode, self._per_transition = _call_tables(
+            self._nx, self._n_guards, self._n_surfaces, self._tr_nx, self.nx_max, self.sc, self._npar,
+            self._guard_len, len(meta["switches"]))
 
     def mode_index(self, mode: str | int) -> int:
         """The index of a mode given by name or index (:class:`~amble.errors.ModelError` if none)."""
@@ -137,11 +143,23 @@ class Kernels:
             return transition
         return _lookup("transition", transition, self._tr_ix, self.n_tr)
 
-    def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
-        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
-        the arrays at them (to keep alive until the call returns). The caller's last parameter
-        array is remembered with its address: it is passed call after call, and holding it keeps
-        its memory where it is (NumPy refuses to resize an array that is referenced)."""
+    def _xp(self, shape: tuple[int], x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
+        """Addresses of a state of ``shape == (nx,)`` and of the parameters, with the arrays at
+        them (to keep alive until the call returns). The common case first: a float64 writable
+        C-contiguous state of that shape and the caller's parameter array of the call before,
+        whose address is remembered; anything else takes :meth:`_xp_any`."""
+        seen = self._p_seen
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                return _addressof(_bytes_of(x)), x, seen[1], p
+            except (TypeError, ValueError, BufferError):  # read-only, not contiguous: converted
+                pass
+        return self._xp_any(shape[0], x, p)
+
+    def _xp_any(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
+        """:meth:`_xp` for any input (see :func:`_arg`). The caller's last parameter array is
+        remembered with its address: it is passed call after call, and holding it keeps its
+        memory where it is (NumPy refuses to resize an array that is referenced)."""
         ax, x = _arg(x, nx, StateError, "state")
         seen = self._p_seen
         if p is seen[0] and p.dtype is _F64:
@@ -156,12 +174,14 @@ class Kernels:
             self._p_seen = (p, ap)
         return ax, x, ap, q
 
+    # Each call below: the mode's (transition's) row of _call_tables — state shape, output buffer
+    # types, output offsets, the index tuples of the views returned — then one C call.
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(nx)
+        m = self._per_mode[mi]
+        ax, x, ap, p = self._xp(m.shape, x, p)
+        buf = m.rhs()
         if self._c_rhs(mi, float(t), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         return _frombuffer(buf)
@@ -170,33 +190,35 @@ class Kernels:
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        n = nx // 2
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(n * n + 2 * n)
+        m = self._per_mode[mi]
+        ax, x, ap, p = self._xp(m.shape, x, p)
+        buf = m.dynamics()  # rows of nq: M, then h, then Γ
         a0 = _addressof(buf)
-        self._c_dynamics(mi, float(t), ax, ap, a0, a0 + 8 * n * n, a0 + 8 * (n * n + n))
-        out = _frombuffer(buf)
-        return out[: n * n].reshape(n, n), out[n * n : n * n + n], out[n * n + n :]
+        self._c_dynamics(mi, float(t), ax, ap, buf, a0 + m.h_at, a0 + m.g_at)
+        out = _frombuffer(buf).reshape(m.dynamics_rows)
+        nq = m.nq
+        return out[:nq], out[nq], out[nq + 1]
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The guard values of the transitions from a mode, in order."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        ax, x, ap, p = self._xp(self._nx[mi], x, p)
-        buf = _out(self._guard_len)
+        m = self._per_mode[mi]
+        ax, x, ap, p = self._xp(m.shape, x, p)
+        buf = m.guards()
         self._c_guards(mi, float(t), ax, ap, buf)
-        return _frombuffer(buf)[: self._n_guards[mi]]
+        return _frombuffer(buf)[: m.n_guards]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
-        ax, x, ap, p = self._xp(self._tr_nx[k][0], x, p)
-        buf = _out(self.nx_max + 1)  # the post state, then the target's index (an int in the last slot)
+        tr = self._per_transition[k]
+        ax, x, ap, p = self._xp(tr.shape, x, p)
+        buf = tr.post()  # the post state (nx_max entries), then the target's index
         a0 = _addressof(buf)
-        if self._c_reset(k, float(t), ax, ap, a0, a0 + 8 * self.nx_max):
+        if self._c_reset(k, float(t), ax, ap, a0, a0 + tr.target_at):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
-        target = ctypes.c_int.from_buffer(buf, 8 * self.nx_max).value
-        return self.meta["modes"][target], _frombuffer(buf)[: self._nx[target]]
+        target = buf.target
+        return self._modes[target], _frombuffer(buf)[: self._nx[target]]
 
     # -- exact derivatives (generated from the symbolic model; see backend/variational_codegen.py)
     def _need_derivatives(self) -> None:
@@ -207,44 +229,44 @@ class Kernels:
     def rhs_jacobian(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
-        self._need_derivatives()
+        if not self._derivatives:
+            self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(nx + nx * self.sc)  # f, then the rows of [∂f/∂x, ∂f/∂p] of sc columns
-        a0 = _addressof(buf)
-        if self._c_rhs_jac_all(mi, float(t), ax, ap, a0, a0 + 8 * nx):
+        m = self._per_mode[mi]
+        ax, x, ap, p = self._xp(m.shape, x, p)
+        buf = m.rhs_jac()  # the rows of [∂f/∂x, ∂f/∂p] (sc columns), then f in a row of its own
+        if self._c_rhs_jac_all(mi, float(t), ax, ap, _addressof(buf) + m.f_at, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        out = _frombuffer(buf)
-        J = out[nx:].reshape(nx, self.sc)
-        return out[:nx], J[:, :nx], J[:, self.nx_max : self.nx_max + self._npar]
+        out = _frombuffer(buf).reshape(m.rhs_jac_rows)
+        return out[m.f], out[m.jx], out[m.jp]
 
     def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray]:
         """``(∂g/∂x, ∂g/∂p)`` of a mode's guards (one row per transition from it, in order), then
         its switching surfaces."""
-        self._need_derivatives()
+        if not self._derivatives:
+            self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(self._surface_len)
+        m = self._per_mode[mi]
+        ax, x, ap, p = self._xp(m.shape, x, p)
+        buf = m.surfaces()
         self._c_surfaces_grad(mi, float(t), ax, ap, buf)
-        rows = self._n_surfaces[mi]
-        G = _frombuffer(buf)[: rows * self.sc].reshape(rows, self.sc)
-        return G[:, :nx], G[:, self.nx_max : self.nx_max + self._npar]
+        G = _frombuffer(buf).reshape(m.surface_rows)
+        return G[m.gx], G[m.gp]
 
     def reset_jacobian(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
-        self._need_derivatives()
+        if not self._derivatives:
+            self._need_derivatives()
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
-        nx, nd = self._tr_nx[k]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(self.nx_max * (self.sc + 1))
+        tr = self._per_transition[k]
+        ax, x, ap, p = self._xp(tr.shape, x, p)
+        buf = tr.jac()
         if self._c_reset_jac(k, float(t), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
-        D = _frombuffer(buf).reshape(self.nx_max, self.sc + 1)
-        return D[:nd, :nx], D[:nd, self.nx_max : self.nx_max + self._npar], D[:nd, self.sc]
+        D = _frombuffer(buf).reshape(tr.jac_rows)
+        return D[tr.dx], D[tr.dp], D[tr.dt]
 
     # -- many states per call: one compiled loop over the rows (amble_rows; the GIL is released)
     def _many(self, op: str, mode: str | int, t: Any, X: Any, p: Any, width: int) -> np.ndarray:
