@@ -33,18 +33,8 @@ _F64 = np.dtype(np.float64)
 _addressof = ctypes.addressof
 _bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1 byte, else an error
 _frombuffer = np.frombuffer
-_OUT: dict[int, type] = {}
 _NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
 _NO_PARAMS_ADDRESS = _NO_PARAMS.ctypes.data
-
-
-def _out(n: int) -> ctypes.Array:
-    """A fresh zeroed C array of ``n`` doubles: the output of one call, handed to C as it is and
-    returned as an ndarray over the same memory (cheaper than an ndarray's address)."""
-    t = _OUT.get(n)
-    if t is None:
-        t = _OUT[n] = ctypes.c_double * max(n, 1)
-    return t()
 
 
 def address(a: np.ndarray) -> int:
@@ -138,50 +128,43 @@ def _rows(t: Any, modes: Any, x: Any, nx_max: int, n_modes: int) -> tuple[np.nda
     return t, modes, np.ascontiguousarray(x)
 
 
-class _ModeCall:
-    """What the per-state calls of one mode need, worked out once (see :func:`_call_tables`)."""
-
-    __slots__ = ("shape", "rhs", "guards", "n_guards", "dynamics", "nq", "dynamics_rows", "h_at", "g_at",
-                 "rhs_jac", "rhs_jac_rows", "f_at", "f", "jx", "jp", "surfaces", "surface_rows", "gx", "gp")
-
-
-class _TransitionCall:
-    """What the per-state calls of one transition need, worked out once (see :func:`_call_tables`)."""
-
-    __slots__ = ("shape", "post", "target_at", "jac", "jac_rows", "dx", "dp", "dt")
+#: The per-state calls that :func:`_call_tables` works out a row for, per mode, then per transition.
+MODE_CALLS = ("rhs", "guards", "dynamics", "rhs_jacobian", "surface_gradients")
+TRANSITION_CALLS = ("reset", "reset_jacobian")
 
 
 def _call_tables(nx: tuple[int, ...], n_guards: tuple[int, ...], n_surfaces: tuple[int, ...],
                  tr_nx: tuple[tuple[int, int], ...], nx_max: int, sc: int, npar: int, guard_len: int, n_switches: int
-                 ) -> tuple[tuple[_ModeCall, ...], tuple[_TransitionCall, ...]]:
-    """Per mode and per transition: the state's shape, the C array types of the outputs (a fresh
-    zeroed one per call; C writes into it and the results are views of it), the byte offsets of
-    outputs after the first, and the index tuples of the views returned. ``n_guards``: each
-    mode's guards; ``n_surfaces``: those plus its switching surfaces; ``tr_nx`` is (source, target) state length
-    per transition; ``sc`` is the columns of a sensitivity row (state, then parameters)."""
+                 ) -> dict[str, tuple[tuple, ...]]:
+    """What each per-state call of ``Kernels`` needs, worked out once: per call (key: the method's
+    name), one row per mode (transition) — the state's shape, the C type of the output buffer (a
+    fresh zeroed one per call; C writes into it and the results returned are views of it), the
+    byte offsets of outputs after the first, the buffer's shape and the indices of the views.
+    ``n_guards``: each mode's guards; ``n_surfaces``: those plus its switching surfaces;
+    ``tr_nx``: (source, target) state length per transition; ``sc``: the columns of a
+    sensitivity row (state, then parameters)."""
     c = ctypes.c_double
     par = slice(nx_max, nx_max + npar)  # the parameter columns of a sensitivity row
-    modes = []
+    n_rows = guard_len + n_switches  # rows of surface gradients written (the longest any mode has)
+    t: dict[str, list[tuple]] = {name: [] for name in MODE_CALLS + TRANSITION_CALLS}
     for n, n_g, rows in zip(nx, n_guards, n_surfaces):
-        m = _ModeCall()
-        m.shape, m.rhs, m.guards, m.n_guards = (n,), c * n, c * guard_len, n_g
-        nq = m.nq = n // 2
-        m.dynamics, m.dynamics_rows = c * ((nq + 2) * nq), (nq + 2, nq)  # M (nq rows), h, Γ
-        m.h_at, m.g_at = 8 * nq * nq, 8 * (nq * nq + nq)
-        m.rhs_jac, m.rhs_jac_rows, m.f_at = c * ((n + 1) * sc), (n + 1, sc), 8 * n * sc  # J rows, then f
-        m.f, m.jx, m.jp = (n, slice(n)), (slice(n), slice(n)), (slice(n), par)
-        m.surfaces, m.surface_rows = c * ((guard_len + n_switches) * sc), (guard_len + n_switches, sc)
-        m.gx, m.gp = (slice(rows), slice(n)), (slice(rows), par)
-        modes.append(m)
+        s, nq = (n,), n // 2
+        t["rhs"].append((s, c * n))
+        t["guards"].append((s, c * guard_len, slice(n_g)))
+        # rows of nq entries: M (nq rows), then h, then Γ
+        t["dynamics"].append((s, c * ((nq + 2) * nq), 8 * nq * nq, 8 * (nq * nq + nq), (nq + 2, nq),
+                              slice(nq), nq, nq + 1))
+        # the rows of [∂f/∂x, ∂f/∂p] (sc columns), then f in a row of its own
+        t["rhs_jacobian"].append((s, c * ((n + 1) * sc), 8 * n * sc, (n + 1, sc),
+                                  (n, slice(n)), (slice(n), slice(n)), (slice(n), par)))
+        t["surface_gradients"].append((s, c * (n_rows * sc), (n_rows, sc), (slice(rows), slice(n)),
+                                       (slice(rows), par)))
 
-    class Post(ctypes.Structure):
+    class Post(ctypes.Structure):  # the post state, then the target's index
         _fields_ = [("x", c * nx_max), ("target", ctypes.c_int)]
 
-    trs = []
     for n, nd in tr_nx:
-        tr = _TransitionCall()
-        tr.shape, tr.post, tr.target_at = (n,), Post, Post.target.offset
-        tr.jac, tr.jac_rows = c * (nx_max * (sc + 1)), (nx_max, sc + 1)
-        tr.dx, tr.dp, tr.dt = (slice(nd), slice(n)), (slice(nd), par), (slice(nd), sc)
-        trs.append(tr)
-    return tuple(modes), tuple(trs)
+        t["reset"].append(((n,), Post, Post.target.offset))
+        t["reset_jacobian"].append(((n,), c * (nx_max * (sc + 1)), (nx_max, sc + 1),
+                                    (slice(nd), slice(n)), (slice(nd), par), (slice(nd), sc)))
+    return {name: tuple(rows) for name, rows in t.items()}

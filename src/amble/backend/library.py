@@ -41,6 +41,20 @@ from .c_args import (
 
 __all__ = ["Kernels"]
 
+#: The per-state entry points: name, result type, number of address arguments (after the mode or
+#: transition index and the time).
+_PER_STATE = (("amble_rhs", ctypes.c_int, 3), ("amble_guards", None, 3), ("amble_reset", ctypes.c_int, 4),
+              ("amble_dynamics", None, 5), ("amble_rhs_jac", ctypes.c_int, 4), ("amble_rhs_jacp", ctypes.c_int, 3),
+              ("amble_rhs_jac_all", ctypes.c_int, 4), ("amble_surfaces_grad", None, 3),
+              ("amble_reset_jac", ctypes.c_int, 3))
+
+
+def _held(lib: ctypes.CDLL, name: str, res: Any, args: int) -> Any:
+    """Entry point ``name`` called without releasing the GIL (``ctypes.PYFUNCTYPE``): a per-state
+    kernel takes well under a microsecond to a few, less than releasing and taking back the GIL
+    costs the call from Python; the loops over many states (``amble_rows``, the batches) release it."""
+    return ctypes.PYFUNCTYPE(res, ctypes.c_int, ctypes.c_double, *[ctypes.c_void_p] * args)((name, lib))
+
 
 class Kernels:
     """ctypes view of one compiled system. Arrays passed in must be C-contiguous float64."""
@@ -72,13 +86,9 @@ class Kernels:
         # The per-state entry points take raw addresses (void *): typed ctypes pointers built per call
         # (ndarray.ctypes.data_as) cost several times the call itself.
         ptrs = lambda n: [ctypes.c_void_p] * n  # noqa: E731
-        for name, res, args in (("amble_rhs", ctypes.c_int, ptrs(3)), ("amble_guards", None, ptrs(3)),
-                                ("amble_reset", ctypes.c_int, ptrs(4)), ("amble_dynamics", None, ptrs(5)),
-                                ("amble_rhs_jac", ctypes.c_int, ptrs(4)), ("amble_rhs_jacp", ctypes.c_int, ptrs(3)),
-                                ("amble_rhs_jac_all", ctypes.c_int, ptrs(4)),
-                                ("amble_surfaces_grad", None, ptrs(3)), ("amble_reset_jac", ctypes.c_int, ptrs(3))):
+        for name, res, args in _PER_STATE:
             f = getattr(lib, name)
-            f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *args]
+            f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *ptrs(args)]
         lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
         lib.amble_rows.restype = ctypes.c_int64
@@ -123,13 +133,16 @@ class Kernels:
         self._derivatives = bool(meta.get("derivatives"))
         self._guard_len = max(self.n_tr, 1)
         self._surface_len = (self._guard_len + len(meta["switches"])) * self.sc
-        self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
-        self._c_dynamics, self._c_rhs_jac_all = lib.amble_dynamics, lib.amble_rhs_jac_all
-        self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
+        c = {name: _held(lib, name, res, args) for name, res, args in _PER_STATE}
+        self._c_rhs, self._c_guards, self._c_reset = c["amble_rhs"], c["amble_guards"], c["amble_reset"]
+        self._c_dynamics, self._c_rhs_jac_all = c["amble_dynamics"], c["amble_rhs_jac_all"]
+        self._c_surfaces_grad, self._c_reset_jac = c["amble_surfaces_grad"], c["amble_reset_jac"]
         self._modes = tuple(modes)
-        self._per_mode, self._per_transition = _call_tables(
-            self._nx, self._n_guards, self._n_surfaces, self._tr_nx, self.nx_max, self.sc, self._npar,
-            self._guard_len, len(meta["switches"]))
+        calls = _call_tables(self._nx, self._n_guards, self._n_surfaces, self._tr_nx, self.nx_max, self.sc,
+                             self._npar, self._guard_len, len(meta["switches"]))
+        self._rhs_calls, self._guards_calls, self._dynamics_calls = calls["rhs"], calls["guards"], calls["dynamics"]
+        self._rhs_jacobian_calls, self._surface_calls = calls["rhs_jacobian"], calls["surface_gradients"]
+        self._reset_calls, self._reset_jacobian_calls = calls["reset"], calls["reset_jacobian"]
 
     def mode_index(self, mode: str | int) -> int:
         """The index of a mode given by name or index (:class:`~amble.errors.ModelError` if none)."""
@@ -143,23 +156,13 @@ class Kernels:
             return transition
         return _lookup("transition", transition, self._tr_ix, self.n_tr)
 
-    def _xp(self, shape: tuple[int], x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
-        """Addresses of a state of ``shape == (nx,)`` and of the parameters, with the arrays at
-        them (to keep alive until the call returns). The common case first: a float64 writable
-        C-contiguous state of that shape and the caller's parameter array of the call before,
-        whose address is remembered; anything else takes :meth:`_xp_any`."""
-        seen = self._p_seen
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                return _addressof(_bytes_of(x)), x, seen[1], p
-            except (TypeError, ValueError, BufferError):  # read-only, not contiguous: converted
-                pass
-        return self._xp_any(shape[0], x, p)
-
     def _xp_any(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
-        """:meth:`_xp` for any input (see :func:`_arg`). The caller's last parameter array is
-        remembered with its address: it is passed call after call, and holding it keeps its
-        memory where it is (NumPy refuses to resize an array that is referenced)."""
+        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
+        the arrays at them (to keep alive until the call returns). The caller's last parameter
+        array is remembered with its address: it is passed call after call, and holding it keeps
+        its memory where it is (NumPy refuses to resize an array that is referenced). Each
+        per-state call first tests inline for the common case: a float64 writable C-contiguous
+        ndarray of the right shape for the state and that same parameter array."""
         ax, x = _arg(x, nx, StateError, "state")
         seen = self._p_seen
         if p is seen[0] and p.dtype is _F64:
@@ -174,14 +177,21 @@ class Kernels:
             self._p_seen = (p, ap)
         return ax, x, ap, q
 
-    # Each call below: the mode's (transition's) row of _call_tables — state shape, output buffer
-    # types, output offsets, the index tuples of the views returned — then one C call.
+    # Each call below: the mode's (transition's) row of its table (c_args._call_tables), the state
+    # and parameter addresses, then one C call into a fresh zeroed buffer, whose views are returned.
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        m = self._per_mode[mi]
-        ax, x, ap, p = self._xp(m.shape, x, p)
-        buf = m.rhs()
+        shape, out_t = self._rhs_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
         if self._c_rhs(mi, float(t), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         return _frombuffer(buf)
@@ -190,32 +200,52 @@ class Kernels:
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        m = self._per_mode[mi]
-        ax, x, ap, p = self._xp(m.shape, x, p)
-        buf = m.dynamics()  # rows of nq: M, then h, then Γ
+        shape, out_t, h_at, g_at, rows, mass, h, g = self._dynamics_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
         a0 = _addressof(buf)
-        self._c_dynamics(mi, float(t), ax, ap, buf, a0 + m.h_at, a0 + m.g_at)
-        out = _frombuffer(buf).reshape(m.dynamics_rows)
-        nq = m.nq
-        return out[:nq], out[nq], out[nq + 1]
+        self._c_dynamics(mi, float(t), ax, ap, buf, a0 + h_at, a0 + g_at)
+        out = _ndarray(rows, _F64, buf)
+        return out[mass], out[h], out[g]
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The guard values of the transitions from a mode, in order."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        m = self._per_mode[mi]
-        ax, x, ap, p = self._xp(m.shape, x, p)
-        buf = m.guards()
+        shape, out_t, own = self._guards_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
         self._c_guards(mi, float(t), ax, ap, buf)
-        return _frombuffer(buf)[: m.n_guards]
+        return _frombuffer(buf)[own]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
-        tr = self._per_transition[k]
-        ax, x, ap, p = self._xp(tr.shape, x, p)
-        buf = tr.post()  # the post state (nx_max entries), then the target's index
+        shape, out_t, target_at = self._reset_calls[k]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
         a0 = _addressof(buf)
-        if self._c_reset(k, float(t), ax, ap, a0, a0 + tr.target_at):
+        if self._c_reset(k, float(t), ax, ap, a0, a0 + target_at):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
         target = buf.target
         return self._modes[target], _frombuffer(buf)[: self._nx[target]]
@@ -232,13 +262,20 @@ class Kernels:
         if not self._derivatives:
             self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        m = self._per_mode[mi]
-        ax, x, ap, p = self._xp(m.shape, x, p)
-        buf = m.rhs_jac()  # the rows of [∂f/∂x, ∂f/∂p] (sc columns), then f in a row of its own
-        if self._c_rhs_jac_all(mi, float(t), ax, ap, _addressof(buf) + m.f_at, buf):
+        shape, out_t, f_at, rows, f, jx, jp = self._rhs_jacobian_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        if self._c_rhs_jac_all(mi, float(t), ax, ap, _addressof(buf) + f_at, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        out = _frombuffer(buf).reshape(m.rhs_jac_rows)
-        return out[m.f], out[m.jx], out[m.jp]
+        out = _ndarray(rows, _F64, buf)
+        return out[f], out[jx], out[jp]
 
     def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray]:
@@ -247,12 +284,19 @@ class Kernels:
         if not self._derivatives:
             self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        m = self._per_mode[mi]
-        ax, x, ap, p = self._xp(m.shape, x, p)
-        buf = m.surfaces()
+        shape, out_t, rows, gx, gp = self._surface_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
         self._c_surfaces_grad(mi, float(t), ax, ap, buf)
-        G = _frombuffer(buf).reshape(m.surface_rows)
-        return G[m.gx], G[m.gp]
+        G = _ndarray(rows, _F64, buf)
+        return G[gx], G[gp]
 
     def reset_jacobian(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -260,13 +304,20 @@ class Kernels:
         if not self._derivatives:
             self._need_derivatives()
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
-        tr = self._per_transition[k]
-        ax, x, ap, p = self._xp(tr.shape, x, p)
-        buf = tr.jac()
+        shape, out_t, rows, dx, dp, dt = self._reset_jacobian_calls[k]
+        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
+        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
+            try:
+                ax, ap = _addressof(_bytes_of(x)), seen[1]
+            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
+                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
         if self._c_reset_jac(k, float(t), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
-        D = _frombuffer(buf).reshape(tr.jac_rows)
-        return D[tr.dx], D[tr.dp], D[tr.dt]
+        D = _ndarray(rows, _F64, buf)
+        return D[dx], D[dp], D[dt]
 
     # -- many states per call: one compiled loop over the rows (amble_rows; the GIL is released)
     def _many(self, op: str, mode: str | int, t: Any, X: Any, p: Any, width: int) -> np.ndarray:
