@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ctypes
 import operator
+import sys
 from typing import Any
 
 import numpy as np
@@ -35,6 +36,31 @@ _bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1
 _frombuffer = np.frombuffer
 _NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
 _NO_PARAMS_ADDRESS = _NO_PARAMS.ctypes.data
+
+
+def _data_field() -> int | None:
+    """Where an ndarray's data pointer sits in the array object, else ``None``: NumPy's
+    ``PyArrayObject_fields`` is the object header, then ``char *data`` — an offset NumPy's own C
+    macro (``PyArray_DATA``) compiles into every extension module, so it cannot move — and CPython's
+    ``id`` is the object's address. Checked here on arrays whose data addresses are known."""
+    if sys.implementation.name != "cpython":
+        return None
+    at = object.__basicsize__  # the object header
+    probes = (np.zeros(3), np.arange(5.0)[1:], np.ones((2, 2)).T)
+    try:
+        ok = all(ctypes.c_void_p.from_address(id(a) + at).value == a.ctypes.data for a in probes)
+    except (OverflowError, ValueError):
+        ok = False
+    return at if ok else None
+
+
+#: A float64 state of shape ``(n,)`` whose strides are :data:`_STEP` (a contiguous one) is read by C
+#: at the address ``_DATA_AT.from_address(id(x) + _DATA).value``, several times cheaper than its
+#: buffer interface; a read-only array too (C only reads a state). Where the data field is not
+#: found, ``_STEP`` is ``None``, which no strides equal: every state then takes the general way.
+_DATA = _data_field()
+_DATA_AT = ctypes.c_void_p.from_address
+_STEP = (8,) if _DATA is not None else None
 
 
 def address(a: np.ndarray) -> int:

@@ -20,12 +20,14 @@ import numpy as np
 from ..errors import CompileError, ModelError, ParameterError, StateError
 from . import abi
 from .c_args import (
+    _DATA,
+    _DATA_AT,
     _F64,
     _NO_PARAMS,
     _NO_PARAMS_ADDRESS,
+    _STEP,
     _addressof,
     _arg,
-    _bytes_of,
     _call_tables,
     _dptr,
     _frombuffer,
@@ -183,12 +185,10 @@ class Kernels:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t = self._rhs_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
@@ -201,12 +201,10 @@ class Kernels:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, h_at, g_at, rows, mass, h, g = self._dynamics_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
@@ -219,12 +217,10 @@ class Kernels:
         """The guard values of the transitions from a mode, in order."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, own = self._guards_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
@@ -235,12 +231,10 @@ class Kernels:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
         shape, out_t, target_at = self._reset_calls[k]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
@@ -263,12 +257,10 @@ class Kernels:
             self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, f_at, rows, f, jx, jp = self._rhs_jacobian_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
@@ -285,12 +277,10 @@ class Kernels:
             self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, rows, gx, gp = self._surface_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
@@ -305,12 +295,10 @@ class Kernels:
             self._need_derivatives()
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
         shape, out_t, rows, dx, dp, dt = self._reset_jacobian_calls[k]
-        seen = self._p_seen  # the common case inline (see _xp_any): a float64 ndarray state, p as before
-        if type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and p is seen[0] and p.dtype is _F64:
-            try:
-                ax, ap = _addressof(_bytes_of(x)), seen[1]
-            except (TypeError, ValueError, BufferError):  # read-only or not contiguous: converted
-                ax, x, ap, p = self._xp_any(shape[0], x, p)
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
