@@ -26,7 +26,6 @@ from .c_args import (
     _NO_PARAMS,
     _NO_PARAMS_ADDRESS,
     _STEP,
-    _addressof,
     _arg,
     _call_tables,
     _dptr,
@@ -49,13 +48,19 @@ _PER_STATE = (("amble_rhs", ctypes.c_int, 3), ("amble_guards", None, 3), ("amble
               ("amble_dynamics", None, 5), ("amble_rhs_jac", ctypes.c_int, 4), ("amble_rhs_jacp", ctypes.c_int, 3),
               ("amble_rhs_jac_all", ctypes.c_int, 4), ("amble_surfaces_grad", None, 3),
               ("amble_reset_jac", ctypes.c_int, 3))
+_void, _double, _byref = ctypes.c_void_p, ctypes.c_double, ctypes.byref
 
 
-def _held(lib: ctypes.CDLL, name: str, res: Any, args: int) -> Any:
-    """Entry point ``name`` called without releasing the GIL (``ctypes.PYFUNCTYPE``): a per-state
-    kernel takes well under a microsecond to a few, less than releasing and taking back the GIL
-    costs the call from Python; the loops over many states (``amble_rows``, the batches) release it."""
-    return ctypes.PYFUNCTYPE(res, ctypes.c_int, ctypes.c_double, *[ctypes.c_void_p] * args)((name, lib))
+def _held(lib: ctypes.CDLL, name: str, res: Any) -> Any:
+    """Entry point ``name`` as the per-state calls call it: without releasing the GIL
+    (``ctypes.PYFUNCTYPE``; a per-state kernel takes less than releasing and taking back the GIL
+    costs — the loops over many states, ``amble_rows`` and the batches, release it) and without
+    argument types, so that ctypes passes every argument as it is instead of calling a converter
+    per argument: the caller hands the index as a Python ``int`` (a C ``int``), the time as a
+    ``c_double`` and every address as a ``c_void_p``, a C array or a ``byref`` — never a plain
+    ``int`` for an address (it would be cut to a C ``int``). (Argument types for the first two
+    only would make ctypes call it as a variadic function, which differs on some platforms.)"""
+    return ctypes.PYFUNCTYPE(res)((name, lib))
 
 
 class Kernels:
@@ -131,11 +136,11 @@ class Kernels:
         self._tr_nx = tuple((self._nx[modes.index(tr["source"])],
                              self._nx[modes.index(tr["target"])] if tr["target"] else
                              self._nx[modes.index(tr["source"])]) for tr in trs)
-        self._p_seen: tuple[Any, int] = (None, 0)
+        self._p_seen: tuple[Any, Any] = (None, None)
         self._derivatives = bool(meta.get("derivatives"))
         self._guard_len = max(self.n_tr, 1)
         self._surface_len = (self._guard_len + len(meta["switches"])) * self.sc
-        c = {name: _held(lib, name, res, args) for name, res, args in _PER_STATE}
+        c = {name: _held(lib, name, res) for name, res, _ in _PER_STATE}
         self._c_rhs, self._c_guards, self._c_reset = c["amble_rhs"], c["amble_guards"], c["amble_reset"]
         self._c_dynamics, self._c_rhs_jac_all = c["amble_dynamics"], c["amble_rhs_jac_all"]
         self._c_surfaces_grad, self._c_reset_jac = c["amble_surfaces_grad"], c["amble_reset_jac"]
@@ -158,29 +163,31 @@ class Kernels:
             return transition
         return _lookup("transition", transition, self._tr_ix, self.n_tr)
 
-    def _xp_any(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
-        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
-        the arrays at them (to keep alive until the call returns). The caller's last parameter
-        array is remembered with its address: it is passed call after call, and holding it keeps
-        its memory where it is (NumPy refuses to resize an array that is referenced). Each
-        per-state call first tests inline for the common case: a float64 writable C-contiguous
-        ndarray of the right shape for the state and that same parameter array."""
+    def _xp_any(self, nx: int, x: Any, p: Any) -> tuple[Any, np.ndarray, Any, np.ndarray]:
+        """Addresses (``c_void_p``) of a state of ``nx`` entries and of the parameters (see
+        :func:`_arg`), with the arrays at them (to keep alive until the call returns). The
+        caller's last parameter array is remembered with its address: it is passed call after
+        call, and holding it keeps its memory where it is (NumPy refuses to resize an array that
+        is referenced). Each per-state call first tests inline for the common case: a contiguous
+        float64 ndarray of the right shape for the state, and that same parameter array."""
         ax, x = _arg(x, nx, StateError, "state")
         seen = self._p_seen
         if p is seen[0] and p.dtype is _F64:
-            return ax, x, seen[1], p
+            return _void(ax), x, seen[1], p
         if self._npar == 0:  # no parameters: any placeholder of ≤ 1 entry (C reads none of it)
             if np.size(p) > 1:
                 raise ParameterError(f"system {self.meta['name']!r} has no parameters, got {np.size(p)} values")
-            q, ap = _NO_PARAMS, _NO_PARAMS_ADDRESS
+            q, ap = _NO_PARAMS, _void(_NO_PARAMS_ADDRESS)
         else:
-            ap, q = _arg(p, self._npar, ParameterError, "parameter vector")
+            a, q = _arg(p, self._npar, ParameterError, "parameter vector")
+            ap = _void(a)
         if type(p) is np.ndarray and (q is p or self._npar == 0):  # only the caller's own array is remembered
             self._p_seen = (p, ap)
-        return ax, x, ap, q
+        return _void(ax), x, ap, q
 
     # Each call below: the mode's (transition's) row of its table (c_args._call_tables), the state
-    # and parameter addresses, then one C call into a fresh zeroed buffer, whose views are returned.
+    # and parameter addresses, then one C call (see _held) into a fresh zeroed buffer, whose views
+    # are returned. A state's address: a c_void_p over the data field of the array (c_args._DATA).
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
@@ -188,11 +195,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        if self._c_rhs(mi, float(t), ax, ap, buf):
+        if self._c_rhs(mi, _double(float(t)), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         return _frombuffer(buf)
 
@@ -204,12 +211,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        a0 = _addressof(buf)
-        self._c_dynamics(mi, float(t), ax, ap, buf, a0 + h_at, a0 + g_at)
+        self._c_dynamics(mi, _double(float(t)), ax, ap, buf, _byref(buf, h_at), _byref(buf, g_at))
         out = _ndarray(rows, _F64, buf)
         return out[mass], out[h], out[g]
 
@@ -220,11 +226,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        self._c_guards(mi, float(t), ax, ap, buf)
+        self._c_guards(mi, _double(float(t)), ax, ap, buf)
         return _frombuffer(buf)[own]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
@@ -234,12 +240,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        a0 = _addressof(buf)
-        if self._c_reset(k, float(t), ax, ap, a0, a0 + target_at):
+        if self._c_reset(k, _double(float(t)), ax, ap, _byref(buf), _byref(buf, target_at)):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
         target = buf.target
         return self._modes[target], _frombuffer(buf)[: self._nx[target]]
@@ -260,11 +265,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        if self._c_rhs_jac_all(mi, float(t), ax, ap, _addressof(buf) + f_at, buf):
+        if self._c_rhs_jac_all(mi, _double(float(t)), ax, ap, _byref(buf, f_at), buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         out = _ndarray(rows, _F64, buf)
         return out[f], out[jx], out[jp]
@@ -280,11 +285,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        self._c_surfaces_grad(mi, float(t), ax, ap, buf)
+        self._c_surfaces_grad(mi, _double(float(t)), ax, ap, buf)
         G = _ndarray(rows, _F64, buf)
         return G[gx], G[gp]
 
@@ -298,11 +303,11 @@ class Kernels:
         seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
         if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
                 and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA).value, seen[1]
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
         else:
             ax, x, ap, p = self._xp_any(shape[0], x, p)
         buf = out_t()
-        if self._c_reset_jac(k, float(t), ax, ap, buf):
+        if self._c_reset_jac(k, _double(float(t)), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
         D = _ndarray(rows, _F64, buf)
         return D[dx], D[dp], D[dt]
