@@ -196,3 +196,19 @@ def test_a_run_reads_read_only_parameters_and_refuses_strided_ones(compass):
     assert got.status == want.status and np.array_equal(got.x, want.x) and got.t == want.t
     with pytest.raises(StateError):
         engine.run(k, np.repeat(p, 2)[::2], 0, x0, steps=1)
+
+
+def test_a_state_is_read_at_its_data_field():
+    """The per-state calls hand C a contiguous state through the data field of the array object
+    (c_args._DATA): on CPython it is found, and it holds the address NumPy reports for any array."""
+    import sys
+
+    from amble.backend import c_args
+
+    if sys.implementation.name != "cpython":
+        assert c_args._STEP is None
+        return
+    assert c_args._DATA is not None and c_args._STEP == (8,)
+    base = np.arange(40.0)
+    for a in (base, base[3:9], base[::2], base.reshape(5, 8)[2], np.zeros(4), np.asfortranarray(base.reshape(5, 8))):
+        assert c_args._DATA_AT(id(a) + c_args._DATA).value == a.ctypes.data

@@ -1,5 +1,6 @@
 """Arrays handed to compiled code and back: their addresses, shapes checked before any address
-reaches C, fresh output buffers, mode and transition indices by name or number.
+reaches C, fresh output buffers (their types and views per mode and transition worked out once),
+mode and transition indices by name or number.
 
 Apart from :class:`~amble.backend.library.Kernels`, which calls the library: these helpers know
 nothing of a library, only of the arrays and indices a call passes (a wrong shape raises the
@@ -54,10 +55,11 @@ def _data_field() -> int | None:
     return at if ok else None
 
 
-#: A float64 state of shape ``(n,)`` whose strides are :data:`_STEP` (a contiguous one) is read by C
-#: at the address ``_DATA_AT.from_address(id(x) + _DATA).value``, several times cheaper than its
-#: buffer interface; a read-only array too (C only reads a state). Where the data field is not
-#: found, ``_STEP`` is ``None``, which no strides equal: every state then takes the general way.
+#: A float64 state of shape ``(n,)`` whose strides are :data:`_STEP` (a contiguous one) is handed to
+#: C as ``_DATA_AT(id(x) + _DATA)``, a ``c_void_p`` over its data field (ctypes passes its value),
+#: several times cheaper than its buffer interface; a read-only array too (C only reads a state).
+#: Where the data field is not found, ``_STEP`` is ``None``, which no strides equal: every state
+#: then takes the general way.
 _DATA = _data_field()
 _DATA_AT = ctypes.c_void_p.from_address
 _STEP = (8,) if _DATA is not None else None
@@ -155,8 +157,8 @@ def _rows(t: Any, modes: Any, x: Any, nx_max: int, n_modes: int) -> tuple[np.nda
 
 
 #: The per-state calls that :func:`_call_tables` works out a row for, per mode, then per transition.
-MODE_CALLS = ("rhs", "guards", "dynamics", "rhs_jacobian", "surface_gradients")
-TRANSITION_CALLS = ("reset", "reset_jacobian")
+_MODE_CALLS = ("rhs", "guards", "dynamics", "rhs_jacobian", "surface_gradients")
+_TRANSITION_CALLS = ("reset", "reset_jacobian")
 
 
 def _call_tables(nx: tuple[int, ...], n_guards: tuple[int, ...], n_surfaces: tuple[int, ...],
@@ -172,7 +174,7 @@ def _call_tables(nx: tuple[int, ...], n_guards: tuple[int, ...], n_surfaces: tup
     c = ctypes.c_double
     par = slice(nx_max, nx_max + npar)  # the parameter columns of a sensitivity row
     n_rows = guard_len + n_switches  # rows of surface gradients written (the longest any mode has)
-    t: dict[str, list[tuple]] = {name: [] for name in MODE_CALLS + TRANSITION_CALLS}
+    t: dict[str, list[tuple]] = {name: [] for name in _MODE_CALLS + _TRANSITION_CALLS}
     for n, n_g, rows in zip(nx, n_guards, n_surfaces):
         s, nq = (n,), n // 2
         t["rhs"].append((s, c * n))

@@ -90,8 +90,8 @@ class Kernels:
         # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
         # evaluation, and building typed ctypes pointers costs more than a walking step.
         lib.amble_simulate.argtypes = [ctypes.c_void_p] * 14
-        # The per-state entry points take raw addresses (void *): typed ctypes pointers built per call
-        # (ndarray.ctypes.data_as) cost several times the call itself.
+        # The per-state entry points, typed here for a caller of the library's own; the per-state
+        # methods call them through prototypes of their own (see _held).
         ptrs = lambda n: [ctypes.c_void_p] * n  # noqa: E731
         for name, res, args in _PER_STATE:
             f = getattr(lib, name)
@@ -139,7 +139,6 @@ class Kernels:
         self._p_seen: tuple[Any, Any] = (None, None)
         self._derivatives = bool(meta.get("derivatives"))
         self._guard_len = max(self.n_tr, 1)
-        self._surface_len = (self._guard_len + len(meta["switches"])) * self.sc
         c = {name: _held(lib, name, res) for name, res, _ in _PER_STATE}
         self._c_rhs, self._c_guards, self._c_reset = c["amble_rhs"], c["amble_guards"], c["amble_reset"]
         self._c_dynamics, self._c_rhs_jac_all = c["amble_dynamics"], c["amble_rhs_jac_all"]
