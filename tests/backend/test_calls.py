@@ -90,6 +90,27 @@ def test_converted_inputs_give_the_same_bits(kp):
     assert np.array_equal(k.rhs(np.int64(0), 0.25, x, p.copy()), want)
 
 
+def test_every_call_gives_the_same_bits_for_converted_states_and_names(kp):
+    """Each per-state call on a state that takes the general way (read-only, strided, a list, a
+    2-D row, another array of parameters) and on a mode or transition by name equals the call on
+    a contiguous float64 state, bit for bit (every output array)."""
+    k, p = kp
+    mode, tr = k.meta["modes"][0], k.meta["transitions"][0]["name"]
+    for x in _states(6, seed=11):
+        ro = x.copy()
+        ro.flags.writeable = False
+        strided = np.repeat(x, 2)[::2]
+        for call, key, name in ((k.rhs, 0, mode), (k.dynamics, 0, mode), (k.guards, 0, mode),
+                                (k.rhs_jacobian, 0, mode), (k.surface_gradients, 0, mode),
+                                (k.reset, 0, tr), (k.reset_jacobian, 0, tr)):
+            want = call(key, 0.5, x, p)
+            for got in (call(name, 0.5, x, p), call(key, np.float32(0.5), ro, p), call(key, 0.5, strided, p.copy()),
+                        call(np.int64(key), 0.5, list(x), list(p)), call(key, 0.5, x[None, :], p)):
+                as_tuple = (lambda r: r if isinstance(r, tuple) else (r,))  # noqa: E731
+                for a, b in zip(as_tuple(got), as_tuple(want)):
+                    assert (a == b) if isinstance(a, str) else (a.shape == b.shape and np.array_equal(a, b))
+
+
 def test_every_call_returns_fresh_arrays(kp):
     k, p = kp
     x0, x1 = _states(2)
@@ -175,3 +196,19 @@ def test_a_run_reads_read_only_parameters_and_refuses_strided_ones(compass):
     assert got.status == want.status and np.array_equal(got.x, want.x) and got.t == want.t
     with pytest.raises(StateError):
         engine.run(k, np.repeat(p, 2)[::2], 0, x0, steps=1)
+
+
+def test_a_state_is_read_at_its_data_field():
+    """The per-state calls hand C a contiguous state through the data field of the array object
+    (c_args._DATA): on CPython it is found, and it holds the address NumPy reports for any array."""
+    import sys
+
+    from amble.backend import c_args
+
+    if sys.implementation.name != "cpython":
+        assert c_args._STEP is None
+        return
+    assert c_args._DATA is not None and c_args._STEP == (8,)
+    base = np.arange(40.0)
+    for a in (base, base[3:9], base[::2], base.reshape(5, 8)[2], np.zeros(4), np.asfortranarray(base.reshape(5, 8))):
+        assert c_args._DATA_AT(id(a) + c_args._DATA).value == a.ctypes.data

@@ -1,5 +1,6 @@
 """Arrays handed to compiled code and back: their addresses, shapes checked before any address
-reaches C, fresh output buffers, mode and transition indices by name or number.
+reaches C, fresh output buffers (their types and views per mode and transition worked out once),
+mode and transition indices by name or number.
 
 Apart from :class:`~amble.backend.library.Kernels`, which calls the library: these helpers know
 nothing of a library, only of the arrays and indices a call passes (a wrong shape raises the
@@ -10,6 +11,7 @@ from __future__ import annotations
 
 import ctypes
 import operator
+import sys
 from typing import Any
 
 import numpy as np
@@ -17,6 +19,8 @@ import numpy as np
 from ..errors import ModelError, StateError
 
 __all__ = ["address"]
+
+_ndarray = np.ndarray
 
 _dptr = ctypes.POINTER(ctypes.c_double)
 _iptr = ctypes.POINTER(ctypes.c_int)
@@ -31,18 +35,34 @@ _F64 = np.dtype(np.float64)
 _addressof = ctypes.addressof
 _bytes_of = ctypes.c_char.from_buffer  # a writable C-contiguous buffer of ≥ 1 byte, else an error
 _frombuffer = np.frombuffer
-_OUT: dict[int, type] = {}
 _NO_PARAMS = np.zeros(1)  # what a system without parameters is given (C reads none of it)
 _NO_PARAMS_ADDRESS = _NO_PARAMS.ctypes.data
 
 
-def _out(n: int) -> ctypes.Array:
-    """A fresh zeroed C array of ``n`` doubles: the output of one call, handed to C as it is and
-    returned as an ndarray over the same memory (cheaper than an ndarray's address)."""
-    t = _OUT.get(n)
-    if t is None:
-        t = _OUT[n] = ctypes.c_double * max(n, 1)
-    return t()
+def _data_field() -> int | None:
+    """Where an ndarray's data pointer sits in the array object, else ``None``: NumPy's
+    ``PyArrayObject_fields`` is the object header, then ``char *data`` — an offset NumPy's own C
+    macro (``PyArray_DATA``) compiles into every extension module, so it cannot move — and CPython's
+    ``id`` is the object's address. Checked here on arrays whose data addresses are known."""
+    if sys.implementation.name != "cpython":
+        return None
+    at = object.__basicsize__  # the object header
+    probes = (np.zeros(3), np.arange(5.0)[1:], np.ones((2, 2)).T)
+    try:
+        ok = all(ctypes.c_void_p.from_address(id(a) + at).value == a.ctypes.data for a in probes)
+    except (OverflowError, ValueError):
+        ok = False
+    return at if ok else None
+
+
+#: A float64 state of shape ``(n,)`` whose strides are :data:`_STEP` (a contiguous one) is handed to
+#: C as ``_DATA_AT(id(x) + _DATA)``, a ``c_void_p`` over its data field (ctypes passes its value),
+#: several times cheaper than its buffer interface; a read-only array too (C only reads a state).
+#: Where the data field is not found, ``_STEP`` is ``None``, which no strides equal: every state
+#: then takes the general way.
+_DATA = _data_field()
+_DATA_AT = ctypes.c_void_p.from_address
+_STEP = (8,) if _DATA is not None else None
 
 
 def address(a: np.ndarray) -> int:
@@ -134,3 +154,45 @@ def _rows(t: Any, modes: Any, x: Any, nx_max: int, n_modes: int) -> tuple[np.nda
     if x.shape[1] < nx_max:
         x = np.hstack([x, np.full((x.shape[0], nx_max - x.shape[1]), np.nan)])
     return t, modes, np.ascontiguousarray(x)
+
+
+#: The per-state calls that :func:`_call_tables` works out a row for, per mode, then per transition.
+_MODE_CALLS = ("rhs", "guards", "dynamics", "rhs_jacobian", "surface_gradients")
+_TRANSITION_CALLS = ("reset", "reset_jacobian")
+
+
+def _call_tables(nx: tuple[int, ...], n_guards: tuple[int, ...], n_surfaces: tuple[int, ...],
+                 tr_nx: tuple[tuple[int, int], ...], nx_max: int, sc: int, npar: int, guard_len: int, n_switches: int
+                 ) -> dict[str, tuple[tuple, ...]]:
+    """What each per-state call of ``Kernels`` needs, worked out once: per call (key: the method's
+    name), one row per mode (transition) — the state's shape, the C type of the output buffer (a
+    fresh zeroed one per call; C writes into it and the results returned are views of it), the
+    byte offsets of outputs after the first, the buffer's shape and the indices of the views.
+    ``n_guards``: each mode's guards; ``n_surfaces``: those plus its switching surfaces;
+    ``tr_nx``: (source, target) state length per transition; ``sc``: the columns of a
+    sensitivity row (state, then parameters)."""
+    c = ctypes.c_double
+    par = slice(nx_max, nx_max + npar)  # the parameter columns of a sensitivity row
+    n_rows = guard_len + n_switches  # rows of surface gradients written (the longest any mode has)
+    t: dict[str, list[tuple]] = {name: [] for name in _MODE_CALLS + _TRANSITION_CALLS}
+    for n, n_g, rows in zip(nx, n_guards, n_surfaces):
+        s, nq = (n,), n // 2
+        t["rhs"].append((s, c * n))
+        t["guards"].append((s, c * guard_len, slice(n_g)))
+        # rows of nq entries: M (nq rows), then h, then Γ
+        t["dynamics"].append((s, c * ((nq + 2) * nq), 8 * nq * nq, 8 * (nq * nq + nq), (nq + 2, nq),
+                              slice(nq), nq, nq + 1))
+        # the rows of [∂f/∂x, ∂f/∂p] (sc columns), then f in a row of its own
+        t["rhs_jacobian"].append((s, c * ((n + 1) * sc), 8 * n * sc, (n + 1, sc),
+                                  (n, slice(n)), (slice(n), slice(n)), (slice(n), par)))
+        t["surface_gradients"].append((s, c * (n_rows * sc), (n_rows, sc), (slice(rows), slice(n)),
+                                       (slice(rows), par)))
+
+    class Post(ctypes.Structure):  # the post state, then the target's index
+        _fields_ = [("x", c * nx_max), ("target", ctypes.c_int)]
+
+    for n, nd in tr_nx:
+        t["reset"].append(((n,), Post, Post.target.offset))
+        t["reset_jacobian"].append(((n,), c * (nx_max * (sc + 1)), (nx_max, sc + 1),
+                                    (slice(nd), slice(n)), (slice(nd), par), (slice(nd), sc)))
+    return {name: tuple(rows) for name, rows in t.items()}

@@ -20,24 +20,47 @@ import numpy as np
 from ..errors import CompileError, ModelError, ParameterError, StateError
 from . import abi
 from .c_args import (
+    _DATA,
+    _DATA_AT,
     _F64,
     _NO_PARAMS,
     _NO_PARAMS_ADDRESS,
-    _addressof,
+    _STEP,
     _arg,
+    _call_tables,
     _dptr,
     _frombuffer,
     _i64ptr,
     _iptr,
     _lookup,
     _matrix,
-    _out,
+    _ndarray,
     _p,
     _rows,
     _vec,
 )
 
 __all__ = ["Kernels"]
+
+#: The per-state entry points: name, result type, number of address arguments (after the mode or
+#: transition index and the time).
+_PER_STATE = (("amble_rhs", ctypes.c_int, 3), ("amble_guards", None, 3), ("amble_reset", ctypes.c_int, 4),
+              ("amble_dynamics", None, 5), ("amble_rhs_jac", ctypes.c_int, 4), ("amble_rhs_jacp", ctypes.c_int, 3),
+              ("amble_rhs_jac_all", ctypes.c_int, 4), ("amble_surfaces_grad", None, 3),
+              ("amble_reset_jac", ctypes.c_int, 3))
+_void, _double, _byref = ctypes.c_void_p, ctypes.c_double, ctypes.byref
+
+
+def _held(lib: ctypes.CDLL, name: str, res: Any) -> Any:
+    """Entry point ``name`` as the per-state calls call it: without releasing the GIL
+    (``ctypes.PYFUNCTYPE``; a per-state kernel takes less than releasing and taking back the GIL
+    costs — the loops over many states, ``amble_rows`` and the batches, release it) and without
+    argument types, so that ctypes passes every argument as it is instead of calling a converter
+    per argument: the caller hands the index as a Python ``int`` (a C ``int``), the time as a
+    ``c_double`` and every address as a ``c_void_p``, a C array or a ``byref`` — never a plain
+    ``int`` for an address (it would be cut to a C ``int``). (Argument types for the first two
+    only would make ctypes call it as a variadic function, which differs on some platforms.)"""
+    return ctypes.PYFUNCTYPE(res)((name, lib))
 
 
 class Kernels:
@@ -67,16 +90,12 @@ class Kernels:
         # Raw addresses (arr.ctypes.data): the hot entry point is called once per return-map
         # evaluation, and building typed ctypes pointers costs more than a walking step.
         lib.amble_simulate.argtypes = [ctypes.c_void_p] * 14
-        # The per-state entry points take raw addresses (void *): typed ctypes pointers built per call
-        # (ndarray.ctypes.data_as) cost several times the call itself.
+        # The per-state entry points, typed here for a caller of the library's own; the per-state
+        # methods call them through prototypes of their own (see _held).
         ptrs = lambda n: [ctypes.c_void_p] * n  # noqa: E731
-        for name, res, args in (("amble_rhs", ctypes.c_int, ptrs(3)), ("amble_guards", None, ptrs(3)),
-                                ("amble_reset", ctypes.c_int, ptrs(4)), ("amble_dynamics", None, ptrs(5)),
-                                ("amble_rhs_jac", ctypes.c_int, ptrs(4)), ("amble_rhs_jacp", ctypes.c_int, ptrs(3)),
-                                ("amble_rhs_jac_all", ctypes.c_int, ptrs(4)),
-                                ("amble_surfaces_grad", None, ptrs(3)), ("amble_reset_jac", ctypes.c_int, ptrs(3))):
+        for name, res, args in _PER_STATE:
             f = getattr(lib, name)
-            f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *args]
+            f.restype, f.argtypes = res, [ctypes.c_int, ctypes.c_double, *ptrs(args)]
         lib.amble_rows_energy.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr]
         lib.amble_rows_kinematics.argtypes = [ctypes.c_int64, _dptr, _iptr, _dptr, _dptr, _dptr, _dptr]
         lib.amble_rows.restype = ctypes.c_int64
@@ -117,13 +136,19 @@ class Kernels:
         self._tr_nx = tuple((self._nx[modes.index(tr["source"])],
                              self._nx[modes.index(tr["target"])] if tr["target"] else
                              self._nx[modes.index(tr["source"])]) for tr in trs)
-        self._p_seen: tuple[Any, int] = (None, 0)
+        self._p_seen: tuple[Any, Any] = (None, None)
         self._derivatives = bool(meta.get("derivatives"))
         self._guard_len = max(self.n_tr, 1)
-        self._surface_len = (self._guard_len + len(meta["switches"])) * self.sc
-        self._c_rhs, self._c_guards, self._c_reset = lib.amble_rhs, lib.amble_guards, lib.amble_reset
-        self._c_dynamics, self._c_rhs_jac_all = lib.amble_dynamics, lib.amble_rhs_jac_all
-        self._c_surfaces_grad, self._c_reset_jac = lib.amble_surfaces_grad, lib.amble_reset_jac
+        c = {name: _held(lib, name, res) for name, res, _ in _PER_STATE}
+        self._c_rhs, self._c_guards, self._c_reset = c["amble_rhs"], c["amble_guards"], c["amble_reset"]
+        self._c_dynamics, self._c_rhs_jac_all = c["amble_dynamics"], c["amble_rhs_jac_all"]
+        self._c_surfaces_grad, self._c_reset_jac = c["amble_surfaces_grad"], c["amble_reset_jac"]
+        self._modes = tuple(modes)
+        calls = _call_tables(self._nx, self._n_guards, self._n_surfaces, self._tr_nx, self.nx_max, self.sc,
+                             self._npar, self._guard_len, len(meta["switches"]))
+        self._rhs_calls, self._guards_calls, self._dynamics_calls = calls["rhs"], calls["guards"], calls["dynamics"]
+        self._rhs_jacobian_calls, self._surface_calls = calls["rhs_jacobian"], calls["surface_gradients"]
+        self._reset_calls, self._reset_jacobian_calls = calls["reset"], calls["reset_jacobian"]
 
     def mode_index(self, mode: str | int) -> int:
         """The index of a mode given by name or index (:class:`~amble.errors.ModelError` if none)."""
@@ -137,32 +162,43 @@ class Kernels:
             return transition
         return _lookup("transition", transition, self._tr_ix, self.n_tr)
 
-    def _xp(self, nx: int, x: Any, p: Any) -> tuple[int, np.ndarray, int, np.ndarray]:
-        """Addresses of a state of ``nx`` entries and of the parameters (see :func:`_arg`), with
-        the arrays at them (to keep alive until the call returns). The caller's last parameter
-        array is remembered with its address: it is passed call after call, and holding it keeps
-        its memory where it is (NumPy refuses to resize an array that is referenced)."""
+    def _xp_any(self, nx: int, x: Any, p: Any) -> tuple[Any, np.ndarray, Any, np.ndarray]:
+        """Addresses (``c_void_p``) of a state of ``nx`` entries and of the parameters (see
+        :func:`_arg`), with the arrays at them (to keep alive until the call returns). The
+        caller's last parameter array is remembered with its address: it is passed call after
+        call, and holding it keeps its memory where it is (NumPy refuses to resize an array that
+        is referenced). Each per-state call first tests inline for the common case: a contiguous
+        float64 ndarray of the right shape for the state, and that same parameter array."""
         ax, x = _arg(x, nx, StateError, "state")
         seen = self._p_seen
         if p is seen[0] and p.dtype is _F64:
-            return ax, x, seen[1], p
+            return _void(ax), x, seen[1], p
         if self._npar == 0:  # no parameters: any placeholder of ≤ 1 entry (C reads none of it)
             if np.size(p) > 1:
                 raise ParameterError(f"system {self.meta['name']!r} has no parameters, got {np.size(p)} values")
-            q, ap = _NO_PARAMS, _NO_PARAMS_ADDRESS
+            q, ap = _NO_PARAMS, _void(_NO_PARAMS_ADDRESS)
         else:
-            ap, q = _arg(p, self._npar, ParameterError, "parameter vector")
+            a, q = _arg(p, self._npar, ParameterError, "parameter vector")
+            ap = _void(a)
         if type(p) is np.ndarray and (q is p or self._npar == 0):  # only the caller's own array is remembered
             self._p_seen = (p, ap)
-        return ax, x, ap, q
+        return _void(ax), x, ap, q
 
+    # Each call below: the mode's (transition's) row of its table (c_args._call_tables), the state
+    # and parameter addresses, then one C call (see _held) into a fresh zeroed buffer, whose views
+    # are returned. A state's address: a c_void_p over the data field of the array (c_args._DATA).
     def rhs(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(nx)
-        if self._c_rhs(mi, float(t), ax, ap, buf):
+        shape, out_t = self._rhs_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        if self._c_rhs(mi, _double(float(t)), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
         return _frombuffer(buf)
 
@@ -170,33 +206,47 @@ class Kernels:
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        n = nx // 2
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(n * n + 2 * n)
-        a0 = _addressof(buf)
-        self._c_dynamics(mi, float(t), ax, ap, a0, a0 + 8 * n * n, a0 + 8 * (n * n + n))
-        out = _frombuffer(buf)
-        return out[: n * n].reshape(n, n), out[n * n : n * n + n], out[n * n + n :]
+        shape, out_t, h_at, g_at, rows, mass, h, g = self._dynamics_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        self._c_dynamics(mi, _double(float(t)), ax, ap, buf, _byref(buf, h_at), _byref(buf, g_at))
+        out = _ndarray(rows, _F64, buf)
+        return out[mass], out[h], out[g]
 
     def guards(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray) -> np.ndarray:
         """The guard values of the transitions from a mode, in order."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        ax, x, ap, p = self._xp(self._nx[mi], x, p)
-        buf = _out(self._guard_len)
-        self._c_guards(mi, float(t), ax, ap, buf)
-        return _frombuffer(buf)[: self._n_guards[mi]]
+        shape, out_t, own = self._guards_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        self._c_guards(mi, _double(float(t)), ax, ap, buf)
+        return _frombuffer(buf)[own]
 
     def reset(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray) -> tuple[str, np.ndarray]:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
-        ax, x, ap, p = self._xp(self._tr_nx[k][0], x, p)
-        buf = _out(self.nx_max + 1)  # the post state, then the target's index (an int in the last slot)
-        a0 = _addressof(buf)
-        if self._c_reset(k, float(t), ax, ap, a0, a0 + 8 * self.nx_max):
+        shape, out_t, target_at = self._reset_calls[k]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        if self._c_reset(k, _double(float(t)), ax, ap, _byref(buf), _byref(buf, target_at)):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
-        target = ctypes.c_int.from_buffer(buf, 8 * self.nx_max).value
-        return self.meta["modes"][target], _frombuffer(buf)[: self._nx[target]]
+        target = buf.target
+        return self._modes[target], _frombuffer(buf)[: self._nx[target]]
 
     # -- exact derivatives (generated from the symbolic model; see backend/variational_codegen.py)
     def _need_derivatives(self) -> None:
@@ -207,44 +257,59 @@ class Kernels:
     def rhs_jacobian(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(f, ∂f/∂x, ∂f/∂p)`` of a mode's right-hand side at a state."""
-        self._need_derivatives()
+        if not self._derivatives:
+            self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(nx + nx * self.sc)  # f, then the rows of [∂f/∂x, ∂f/∂p] of sc columns
-        a0 = _addressof(buf)
-        if self._c_rhs_jac_all(mi, float(t), ax, ap, a0, a0 + 8 * nx):
+        shape, out_t, f_at, rows, f, jx, jp = self._rhs_jacobian_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        if self._c_rhs_jac_all(mi, _double(float(t)), ax, ap, _byref(buf, f_at), buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
-        out = _frombuffer(buf)
-        J = out[nx:].reshape(nx, self.sc)
-        return out[:nx], J[:, :nx], J[:, self.nx_max : self.nx_max + self._npar]
+        out = _ndarray(rows, _F64, buf)
+        return out[f], out[jx], out[jp]
 
     def surface_gradients(self, mode: str | int, t: float, x: np.ndarray, p: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray]:
         """``(∂g/∂x, ∂g/∂p)`` of a mode's guards (one row per transition from it, in order), then
         its switching surfaces."""
-        self._need_derivatives()
+        if not self._derivatives:
+            self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
-        nx = self._nx[mi]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(self._surface_len)
-        self._c_surfaces_grad(mi, float(t), ax, ap, buf)
-        rows = self._n_surfaces[mi]
-        G = _frombuffer(buf)[: rows * self.sc].reshape(rows, self.sc)
-        return G[:, :nx], G[:, self.nx_max : self.nx_max + self._npar]
+        shape, out_t, rows, gx, gp = self._surface_calls[mi]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        self._c_surfaces_grad(mi, _double(float(t)), ax, ap, buf)
+        G = _ndarray(rows, _F64, buf)
+        return G[gx], G[gp]
 
     def reset_jacobian(self, transition: str | int, t: float, x: np.ndarray, p: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(∂Δ/∂x, ∂Δ/∂p, ∂Δ/∂t)`` of a transition's reset at a pre-event state."""
-        self._need_derivatives()
+        if not self._derivatives:
+            self._need_derivatives()
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
-        nx, nd = self._tr_nx[k]
-        ax, x, ap, p = self._xp(nx, x, p)
-        buf = _out(self.nx_max * (self.sc + 1))
-        if self._c_reset_jac(k, float(t), ax, ap, buf):
+        shape, out_t, rows, dx, dp, dt = self._reset_jacobian_calls[k]
+        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
+        else:
+            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        buf = out_t()
+        if self._c_reset_jac(k, _double(float(t)), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
-        D = _frombuffer(buf).reshape(self.nx_max, self.sc + 1)
-        return D[:nd, :nx], D[:nd, self.nx_max : self.nx_max + self._npar], D[:nd, self.sc]
+        D = _ndarray(rows, _F64, buf)
+        return D[dx], D[dp], D[dt]
 
     # -- many states per call: one compiled loop over the rows (amble_rows; the GIL is released)
     def _many(self, op: str, mode: str | int, t: Any, X: Any, p: Any, width: int) -> np.ndarray:
