@@ -167,8 +167,9 @@ class Kernels:
         :func:`_arg`), with the arrays at them (to keep alive until the call returns). The
         caller's last parameter array is remembered with its address: it is passed call after
         call, and holding it keeps its memory where it is (NumPy refuses to resize an array that
-        is referenced). Each per-state call first tests inline for the common case: a contiguous
-        float64 ndarray of the right shape for the state, and that same parameter array."""
+        is referenced). Each per-state call first tests for the common case: a contiguous
+        float64 ndarray of the right shape for the state, and that same parameter array
+        (:meth:`_addresses`)."""
         ax, x = _arg(x, nx, StateError, "state")
         seen = self._p_seen
         if p is seen[0] and p.dtype is _F64:
@@ -184,6 +185,16 @@ class Kernels:
             self._p_seen = (p, ap)
         return _void(ax), x, ap, q
 
+    def _addresses(self, shape: tuple[int], x: Any, p: Any) -> tuple[Any, Any, Any, Any]:
+        """A per-state call's state and parameter addresses with the arrays at them (to keep
+        alive until the call returns): the common case first — a contiguous float64 state of
+        ``shape`` and the parameter array of the previous call — else :meth:`_xp_any`."""
+        seen = self._p_seen
+        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
+                and p is seen[0] and p.dtype is _F64):
+            return _DATA_AT(id(x) + _DATA), x, seen[1], p
+        return self._xp_any(shape[0], x, p)
+
     # Each call below: the mode's (transition's) row of its table (c_args._call_tables), the state
     # and parameter addresses, then one C call (see _held) into a fresh zeroed buffer, whose views
     # are returned. A state's address: a c_void_p over the data field of the array (c_args._DATA).
@@ -191,12 +202,7 @@ class Kernels:
         """The right-hand side ``dx/dt`` of a mode at a state (units of the state per time unit)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t = self._rhs_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         if self._c_rhs(mi, _double(float(t)), ax, ap, buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
@@ -207,12 +213,7 @@ class Kernels:
         """Mass matrix ``M``, bias ``h`` and generalized force ``Γ`` at a state (``M q̈ + h = Γ``)."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, h_at, g_at, rows, mass, h, g = self._dynamics_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         self._c_dynamics(mi, _double(float(t)), ax, ap, buf, _byref(buf, h_at), _byref(buf, g_at))
         out = _ndarray(rows, _F64, buf)
@@ -222,12 +223,7 @@ class Kernels:
         """The guard values of the transitions from a mode, in order."""
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, own = self._guards_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         self._c_guards(mi, _double(float(t)), ax, ap, buf)
         return _frombuffer(buf)[own]
@@ -236,12 +232,7 @@ class Kernels:
         """Apply a transition's reset to a pre-event state; returns (target mode, post state)."""
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
         shape, out_t, target_at = self._reset_calls[k]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         if self._c_reset(k, _double(float(t)), ax, ap, _byref(buf), _byref(buf, target_at)):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
@@ -261,12 +252,7 @@ class Kernels:
             self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, f_at, rows, f, jx, jp = self._rhs_jacobian_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         if self._c_rhs_jac_all(mi, _double(float(t)), ax, ap, _byref(buf, f_at), buf):
             raise ModelError(f"mass matrix is singular or ill-conditioned at state {x.tolist()}")
@@ -281,12 +267,7 @@ class Kernels:
             self._need_derivatives()
         mi = mode if type(mode) is int and 0 <= mode < self.n_modes else self.mode_index(mode)
         shape, out_t, rows, gx, gp = self._surface_calls[mi]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         self._c_surfaces_grad(mi, _double(float(t)), ax, ap, buf)
         G = _ndarray(rows, _F64, buf)
@@ -299,12 +280,7 @@ class Kernels:
             self._need_derivatives()
         k = transition if type(transition) is int and 0 <= transition < self.n_tr else self.transition_index(transition)
         shape, out_t, rows, dx, dp, dt = self._reset_jacobian_calls[k]
-        seen = self._p_seen  # the common case inline (see _xp_any): a contiguous float64 state, p as before
-        if (type(x) is _ndarray and x.dtype is _F64 and x.shape == shape and x.strides == _STEP
-                and p is seen[0] and p.dtype is _F64):
-            ax, ap = _DATA_AT(id(x) + _DATA), seen[1]
-        else:
-            ax, x, ap, p = self._xp_any(shape[0], x, p)
+        ax, x, ap, p = self._addresses(shape, x, p)
         buf = out_t()
         if self._c_reset_jac(k, _double(float(t)), ax, ap, buf):
             raise ModelError(f"reset of {self.meta['transitions'][k]['name']!r} failed (singular impulse system)")
