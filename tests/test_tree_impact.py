@@ -140,3 +140,38 @@ def test_stance_feet_walker_needs_a_pivot_at_the_stance_foot(urdf):
                            base_coordinate="stance", pivot="left_sole", contact_points=SOLES)
     with pytest.raises(ModelError, match="revolute or spherical"):
         base_relabel(right, free)  # a floating base has no pivot to turn about
+
+
+def test_a_foot_frame_merged_into_the_shin_can_be_the_next_base():
+    """RABBIT's feet are massless frames on fixed joints (merged into the tibias): rooted at either
+    foot as two stance modes, its footfall equals the one-mode walker's that relabels the legs by
+    hand (the new stance angle the old swing foot's absolute angle, written out)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from two_mode_walkers import rabbit_two_modes
+
+    from amble import walker
+
+    two = rabbit_two_modes()
+    one = Model.from_urdf(DATA / "rabbit.urdf", base="left_foot", base_joint=Joint("revolute", axis=(0, 1, 0)),
+                          base_coordinate="stance")
+    q = {str(s): s for s in one.q}
+    swap = {q["left_knee"]: q["right_knee"], q["left_hip"]: q["right_hip"], q["right_hip"]: q["left_hip"],
+            q["right_knee"]: q["left_knee"],
+            q["stance"]: q["stance"] - q["left_knee"] - q["left_hip"] + q["right_hip"] + q["right_knee"]}
+    step = walker(one, foot="right_foot", hip="torso", slope=0.0, relabel=swap)
+    names = [str(s) for s in one.q]
+    assert names == [str(s) for s in two.modes["left"].q]
+    n = len(names)
+    x0 = np.zeros(2 * n)
+    x0[names.index("left_hip")], x0[names.index("right_hip")] = 0.3, -0.2
+    x0[names.index("right_knee")] = 0.1
+    x0[n + names.index("stance")] = -1.1
+    a = simulate(step, x0=x0, steps=1, t_end=3.0).step_events[0]
+    b = simulate(two, x0=x0, steps=1, t_end=3.0).step_events[0]
+    # the right mode's coordinates are (stance, right_knee, right_hip, left_hip, left_knee): the
+    # one-mode walker's after its swap
+    assert [str(s) for s in two.modes["right"].q] == ["stance", "right_knee", "right_hip", "left_hip", "left_knee"]
+    assert b.t == pytest.approx(a.t, rel=1e-12)
+    assert np.abs(b.x_post - a.x_post).max() <= 1e-10 * np.abs(a.x_post).max()

@@ -58,11 +58,16 @@ def _atan2(y: sp.Expr, x: sp.Expr) -> sp.Expr:
 def base_relabel(source: Model, target: Model) -> dict[sp.Symbol, sp.Expr]:
     """The coordinates of ``target``'s base joint as expressions of ``source``'s coordinates:
     the orientation that ``target``'s base link has in ``source`` (module docstring). Both
-    models are trees over the same links; the base joint is ``revolute`` or ``spherical``,
+    models are trees over the same links (the base link may be a massless frame that ``source``
+    merged into the body it hangs from); the base joint is ``revolute`` or ``spherical``,
     centred at the origin."""
     chain = _base_chain(target)
     link = chain[-1].name
-    if not isinstance(source.tree, RigidTree) or link not in source.tree.com_points:
+    ts = source.tree
+    # the link is a body of the source's tree, or a massless frame merged into one (a foot frame
+    # on a fixed joint below the shin: its rotation is the body's times the frame's)
+    frame = getattr(ts, "link_frames", {}).get(link) if isinstance(ts, RigidTree) else None
+    if not isinstance(ts, RigidTree) or (link not in ts.com_points and (frame is None or frame[0] is None)):
         raise ModelError(f"model {source.name!r}: no link {link!r} (the base of {target.name!r})")
     first, last = chain[0].joint, chain[-1].joint
     if any(float(v) != 0.0 for v in first.xyz):
@@ -72,8 +77,11 @@ def base_relabel(source: Model, target: Model) -> dict[sp.Symbol, sp.Expr]:
     axes = [tuple(np.round(np.asarray(b.joint.axis, float), 12)) for b in chain]
     Ro = _mat3(first.rotation) if first.rotation is not None else _mat3(rpy_matrix(first.rpy))
     Rp = _mat3(last.post_rotation) if last.post_rotation is not None else sp.eye(3)
-    ts = source.tree
-    R = ts.defs.expand(ts[link].R)
+    if link in ts.com_points:
+        R = ts.defs.expand(ts[link].R)
+    else:
+        body, Rf, _ = frame
+        R = _matmul(ts.defs.expand(ts[body].R), _mat3(Rf))
     Q = R if Ro == sp.eye(3) else _matmul(Ro.T, R)
     Q = Q if Rp == sp.eye(3) else _matmul(Q, Rp.T)
     if kinds == ["revolute"]:
