@@ -60,7 +60,7 @@ def find_fixed_point(
     guess: Sequence[float] | None = None,
     *,
     params: Mapping[str, float] | None = None,
-    period: int = 1,
+    period: int | None = None,
     rtol: float = FIXED_POINT_TOL,
     atol: float = FIXED_POINT_TOL,
     tol: float = RESIDUAL_TOL,
@@ -68,6 +68,11 @@ def find_fixed_point(
     jacobian: str = "exact",
 ) -> LimitCycle:
     """Fixed point of the ``period``-step return map, its step time and Floquet multipliers.
+
+    ``period`` counts footfalls; by default it is the system's footfall cycle (1 for a one-mode
+    walker, 2 for a walker whose stance feet are modes: after one footfall it is in the other
+    mode, :func:`amble.analysis.mode_cycle.footfall_cycle`), and a period that is not a multiple
+    of that cycle raises :class:`StateError` before any run. The step time is per footfall.
 
     Damped Newton in reduced section coordinates; ``tol`` bounds the residual
     ``|P(x) − x|∞`` of the returned post-impact state. ``jacobian``: ``"exact"`` (variational
@@ -89,9 +94,12 @@ def find_fixed_point(
     if jacobian not in ("exact", "fd"):
         raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
     P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
+    period = P.period
     at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
     start = _scaled_start(system, P) if guess is None and not at_defaults else None
-    x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params, start=start)
+    # a whole number of footfall cycles: the walk ends in the section's mode
+    walk = -(-30 // _cycle_length(P)) * _cycle_length(P)
+    x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params, walk, start)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
         direct = _newton(system, P, x, period, tol, max_iter, jacobian)
@@ -112,7 +120,7 @@ def find_fixed_point(
 
 
 def continue_fixed_point(system: HybridSystem, x: Sequence[float], from_params: Mapping[str, float],
-                         params: Mapping[str, float], *, period: int = 1, rtol: float = FIXED_POINT_TOL,
+                         params: Mapping[str, float], *, period: int | None = None, rtol: float = FIXED_POINT_TOL,
                          atol: float = FIXED_POINT_TOL, tol: float = RESIDUAL_TOL, max_iter: int = 40) -> LimitCycle:
     """The gait ``x`` (a fixed point at ``from_params``) carried to ``params`` along its branch
     (:func:`amble.analysis.homotopy.follow`: tangent predictor from the exact parameter
@@ -121,6 +129,7 @@ def continue_fixed_point(system: HybridSystem, x: Sequence[float], from_params: 
     from .homotopy import follow
 
     P = ReturnMap(system, params, period=period, rtol=rtol, atol=atol)
+    period = P.period  # (default: the footfall cycle, as find_fixed_point)
     Q = ReturnMap(system, from_params, period=period, rtol=rtol, atol=atol, mode=P.mode)
     try:
         xe = follow(Q, np.asarray(x, float), Q.p.copy(), P.p.copy(), tol=tol)
@@ -270,9 +279,18 @@ def _refuse_rest(system: HybridSystem, P: ReturnMap, x: np.ndarray, T: float) ->
                                f"{T:.3g} s, the model measures {size:.3g}): not a gait")
 
 
+def _cycle_length(P: ReturnMap) -> int:
+    """Footfalls in the system's footfall cycle from the section's mode (1 when not unique)."""
+    return len(P.cycle) if P.cycle else 1
+
+
 def _lower_period(P: ReturnMap, x: np.ndarray, period: int, tol: float) -> int:
-    """The smallest proper divisor d of ``period`` with P_d(x) = x (within 100 tol), or 0."""
-    for d in range(1, period):
+    """The smallest proper divisor d of ``period`` with P_d(x) = x (within 100 tol), or 0. Only
+    multiples of the footfall cycle are periods: after another number of footfalls the walker
+    is in another mode, where a symmetric gait's state has the fixed point's very numbers (the
+    mode check refuses it too, at the price of a run)."""
+    c = _cycle_length(P)
+    for d in range(c, period, c):
         if period % d:
             continue
         r = run(P.k, P.p, P.mi, x, steps=d, opts=P.opts)

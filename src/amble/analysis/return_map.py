@@ -26,6 +26,7 @@ from ..errors import ModelError, SimulationError, StateError
 from ..simulation.engine import Options, Sensitivity, run
 from ..simulation.simulate import parameter_vector
 from .defaults import FIXED_POINT_TOL
+from .mode_cycle import footfall_cycle, section_period
 from .section import Section
 from .section import chart as _chart
 
@@ -48,10 +49,20 @@ class ReturnMap:
     ``__call__(x)`` maps a post-impact state to the post-impact state ``k`` footfalls later and
     returns it with the elapsed time; a run that does not complete its steps raises
     :class:`SimulationError` with the outcome.
+
+    ``period`` (k) counts footfalls. By default it is the length of the system's footfall cycle
+    from ``mode`` (:func:`amble.analysis.mode_cycle.footfall_cycle`): 1 for a one-mode walker, 2
+    for a walker whose stance feet are modes (left → right → left); a period that is not a
+    multiple of that length raises :class:`StateError`, since the state it maps to lies in
+    another mode.
     """
 
-    def __init__(self, system: HybridSystem, params: Mapping[str, float] | None = None, *, period: int = 1,
+    def __init__(self, system: HybridSystem, params: Mapping[str, float] | None = None, *, period: int | None = None,
                  rtol: float = FIXED_POINT_TOL, atol: float = FIXED_POINT_TOL, mode: str | None = None) -> None:
+        # footfalls until the system is back in the section's mode: the default period, and every
+        # period a multiple of it (checked here, before anything is compiled or run)
+        cycle = footfall_cycle(system, mode)
+        period = section_period(system, period, mode)
         if period < 1:
             raise StateError(f"period must be at least 1, got {period}")
         if period > MAX_PERIOD:
@@ -63,6 +74,9 @@ class ReturnMap:
         self.k: Kernels = compiled(system, derivatives=True)  # exact Jacobians, the section's chart
         self.p = parameter_vector(self.k, params, system)
         self.period = period
+        #: the modes of the post-impact states of successive footfalls, this map's mode first
+        #: (:func:`amble.analysis.mode_cycle.footfall_cycle`), or None when they are not one cycle
+        self.cycle = cycle
         self.mode = mode or self.k.meta["modes"][0]
         self.mi = self.k.mode_index(self.mode)
         mst = system.max_step_time

@@ -20,8 +20,10 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
                model_args: Callable[[argparse.ArgumentParser, float | None], None]) -> None:
     lc = add("limit-cycle", "find the periodic gait, its step time and Floquet multipliers")
     model_args(lc, FIXED_POINT_TOL)
-    lc.add_argument("--period", type=int, default=1,
-                    help="k for a period-k gait (default 1); all k points and step times are reported")
+    lc.add_argument("--period", type=int, default=None,
+                    help="k for a gait of k footfalls (default: the footfalls until the walker is back in its "
+                         "first mode, 1 for most walkers, 2 when its stance feet are modes); all k points and "
+                         "step times are reported")
     lc.add_argument("--tol", type=float, default=RESIDUAL_TOL,
                     help=f"fixed-point tolerance: the largest residual |P(x) - x| of the gait (default "
                          f"{RESIDUAL_TOL:g}, so that the fixed point is within 1e-10 of the map's)")
@@ -40,7 +42,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     # before the model is loaded
     from ..analysis.return_map import MAX_PERIOD
 
-    if not 1 <= args.period <= MAX_PERIOD:
+    if args.period is not None and not 1 <= args.period <= MAX_PERIOD:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
     # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
     s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True, **robot_options(args))
@@ -62,7 +64,7 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
     if plot_p or anim_p:
         from ..simulation.simulate import simulate
 
-        tr = simulate(s, lc.fixed_point, params=params, steps=max(args.period, 2) if plot_p and not anim_p else 12,
+        tr = simulate(s, lc.fixed_point, params=params, steps=max(lc.period, 2) if plot_p and not anim_p else 12,
                       rtol=args.rtol, atol=args.atol, sample_dt=1.0 / 200)
         if plot_p:
             from ..viz.plot import plot_limit_cycle
