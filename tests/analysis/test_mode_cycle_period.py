@@ -136,3 +136,16 @@ def test_limit_cycle_cli_finds_the_two_footfall_gait_without_being_told(capsys, 
     out = capsys.readouterr()
     assert code == 2 and out.out == ""
     assert out.err.strip().splitlines() == [f"amble: error: {ONE_FOOTFALL}"]
+
+
+def test_gaits_of_two_stance_modes_are_searched_at_multiples_of_two_footfalls(capsys, two, gait):
+    from amble.analysis.gaits import find_gaits
+
+    found = find_gaits(two, seeds=0)
+    assert found.max_period == 2 and [g.period for g in found] == [2]
+    np.testing.assert_allclose(found[0].fixed_point, gait.fixed_point, rtol=0, atol=1e-9)
+    with pytest.raises(StateError, match="period 1: .* multiple of 2 footfalls"):
+        find_gaits(two, period=1, seeds=0)
+    code = main(["gaits", MODEL_FILE, "--period", "1"])
+    out = capsys.readouterr()
+    assert code == 2 and out.err.strip().splitlines() == [f"amble: error: {ONE_FOOTFALL}"]

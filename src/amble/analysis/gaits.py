@@ -56,6 +56,7 @@ from ..errors import AmbleError, ConvergenceError, SimulationError, StateError
 from ..simulation.simulate import initial_state
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .limit_cycle import LimitCycle
+from .mode_cycle import footfalls_per_cycle, section_period
 from .poincare import default_guess, find_fixed_point
 from .return_map import MAX_PERIOD, ReturnMap
 from .section import Section
@@ -105,7 +106,7 @@ def find_gaits(
     system: HybridSystem,
     *,
     params: Mapping[str, float] | None = None,
-    period: int = 1,
+    period: int | None = None,
     tol: float = RESIDUAL_TOL,
     seeds: int | Sequence[Sequence[float]] = 24,
     guesses: Sequence[Sequence[float]] = (),
@@ -119,6 +120,11 @@ def find_gaits(
 ) -> Gaits:
     """Every gait of period 1 … ``period`` that the seeded, deflated search finds (module doc).
 
+    Periods count footfalls. A system whose footfalls cycle through c modes (c = 2 for a walker
+    whose stance feet are modes, :func:`amble.analysis.mode_cycle.footfall_cycle`) has gaits of
+    c, 2c, … footfalls only: those are searched, ``period`` defaults to c, and a ``period`` below
+    c raises :class:`StateError`.
+
     ``params``: parameter overrides; ``tol``: the residual ``|P_k(x) − x|∞`` of every gait
     returned; ``seeds``: the number of Halton seeds around the reference state (besides the
     reference states themselves), or the seeds as full post-impact states (``state_names``
@@ -128,12 +134,16 @@ def find_gaits(
     iterations of one run; ``rtol``, ``atol``: integrator tolerances;
     ``progress``: a progress bar (default: on a terminal only).
     """
+    c = footfalls_per_cycle(system)
+    period = c if period is None else period
     if not 1 <= period <= MAX_PERIOD:
         raise StateError(f"period must be at least 1 and at most {MAX_PERIOD}, got {period}")
+    if period < c:
+        section_period(system, period)  # says why: the walker is in another mode after fewer footfalls
     if not (tol > 0 and spread >= 0 and per_seed >= 1 and max_iter >= 1):
         raise StateError(f"find_gaits needs tol > 0, spread ≥ 0, per_seed ≥ 1, max_iter ≥ 1; got tol={tol}, "
                          f"spread={spread}, per_seed={per_seed}, max_iter={max_iter}")
-    P1 = ReturnMap(system, params, period=1, rtol=rtol, atol=atol)
+    P1 = ReturnMap(system, params, period=c, rtol=rtol, atol=atol)  # the shortest period there is
     names = list(P1.k.meta["params"])
     values = dict(zip(names, P1.p.tolist()))
     starts = [initial_state(system, P1.k, x, P1.mode)[1] for x in guesses]
@@ -141,11 +151,12 @@ def find_gaits(
     out = Gaits(system=system.name, parameters=values, max_period=period, seeds=len(starts))
     from tqdm.auto import tqdm
 
-    bar = tqdm(total=period * len(starts), desc=f"gaits of {system.name}", unit="seed",
+    periods = range(c, period + 1, c)
+    bar = tqdm(total=len(periods) * len(starts), desc=f"gaits of {system.name}", unit="seed",
                disable=None if progress is None else not progress, leave=False)
     try:
-        for k in range(1, period + 1):
-            Pk = P1 if k == 1 else ReturnMap(system, values, period=k, rtol=rtol, atol=atol)
+        for k in periods:
+            Pk = P1 if k == c else ReturnMap(system, values, period=k, rtol=rtol, atol=atol)
             # first beside the shorter gaits, along their flip directions: where a period-k orbit
             # was born of a shorter one, it lies there
             for x0 in _beside(system, out, k, values, rtol, atol):

@@ -23,6 +23,7 @@ from ..simulation.engine import run
 from ..simulation.simulate import initial_state, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .limit_cycle import LimitCycle
+from .mode_cycle import footfalls_per_cycle
 from .return_map import CHART_GROWTH, MAX_PERIOD, ReturnMap
 
 if TYPE_CHECKING:
@@ -42,7 +43,11 @@ def default_guess(system: HybridSystem, params: Mapping[str, float] | None = Non
                   start: Sequence[float] | None = None) -> np.ndarray:
     """A fixed-point guess: walk ``steps`` steps from ``start`` (default: the system's guess, or
     its default start) at these parameters and take the last post-impact state; the start
-    itself if that walk fails."""
+    itself if that walk fails. ``steps`` is rounded up to whole footfall cycles
+    (:func:`amble.analysis.mode_cycle.footfall_cycle`), so that a walker whose stance feet are
+    modes ends in the mode it started in."""
+    c = footfalls_per_cycle(system)
+    steps = -(-steps // c) * c
     start = system.fixed_point_guess if start is None else start
     if start is None and not system.default_start:
         raise ConvergenceError(f"system {system.name!r} has neither a fixed-point guess nor a default start")
@@ -97,9 +102,7 @@ def find_fixed_point(
     period = P.period
     at_defaults = np.array_equal(P.p, np.asarray(P.k.meta["param_defaults"], float))
     start = _scaled_start(system, P) if guess is None and not at_defaults else None
-    # a whole number of footfall cycles: the walk ends in the section's mode
-    walk = -(-30 // _cycle_length(P)) * _cycle_length(P)
-    x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params, walk, start)
+    x0 = np.asarray(guess, float) if guess is not None else default_guess(system, params, start=start)
     _, x = initial_state(system, P.k, x0, P.mode)
     try:
         direct = _newton(system, P, x, period, tol, max_iter, jacobian)

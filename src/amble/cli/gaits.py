@@ -20,7 +20,9 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
     g = add("gaits", "every gait of period 1..K found at these parameters (stable and unstable): seeds on the "
                      "post-impact section, Newton with deflation of the gaits already found")
     model_arg(g)
-    g.add_argument("--period", type=int, default=1, help=f"K: search periods 1..K (default 1, at most {MAX_PERIOD})")
+    g.add_argument("--period", type=int, default=None,
+                   help=f"K: search periods 1..K, in footfalls (default: the footfalls until the walker is back in "
+                        f"its first mode, 1 for most walkers, 2 when its stance feet are modes; at most {MAX_PERIOD})")
     g.add_argument("--tol", type=float, default=RESIDUAL_TOL,
                    help=f"largest residual |P(x) - x| of a gait returned (default {RESIDUAL_TOL:g})")
     g.add_argument("--seeds", type=int, default=24, help="seeds around the model's gait besides it (default 24)")
@@ -50,7 +52,7 @@ def _guess(text: str) -> list[float]:
 def cmd_gaits(args: argparse.Namespace) -> dict[str, Any]:
     from ..analysis.gaits import find_gaits
 
-    if not 1 <= args.period <= MAX_PERIOD:
+    if args.period is not None and not 1 <= args.period <= MAX_PERIOD:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
     if not (args.tol > 0 and args.rtol > 0 and args.atol > 0):
         raise UsageError(f"--tol, --rtol and --atol must be positive, got {args.tol:g}, {args.rtol:g}, {args.atol:g}")
@@ -64,7 +66,7 @@ def cmd_gaits(args: argparse.Namespace) -> dict[str, Any]:
                        guesses=guesses, spread=args.spread, seed=args.seed, rtol=args.rtol, atol=args.atol)
     if not args.json:
         unit = getattr(system, "time_unit", "s")
-        print(f"{system.name}: {len(found)} gait{'' if len(found) == 1 else 's'} of period 1..{args.period} "
+        print(f"{system.name}: {len(found)} gait{'' if len(found) == 1 else 's'} of period 1..{found.max_period} "
               f"({found.seeds} seeds; Newton runs: {found.fell} fell, {found.diverged} did not converge)")
         for i, g in enumerate(found, 1):
             times = ", ".join(f"{t:.6g}" for t in g.step_times) if g.period > 1 else f"{g.step_time:.6g}"
