@@ -43,7 +43,7 @@ CORRECTOR_ITER = 8
 class _Problem:
     """``F(x, λ) = P_k(x; λ) − x`` with its exact Jacobian, and the multipliers of a gait."""
 
-    def __init__(self, system: HybridSystem, params: Mapping[str, float] | None, param: str, period: int,
+    def __init__(self, system: HybridSystem, params: Mapping[str, float] | None, param: str, period: int | None,
                  rtol: float, atol: float) -> None:
         from .return_map import ReturnMap
 
@@ -54,7 +54,7 @@ class _Problem:
         self.j = names.index(param)
         self.P.p = self.P.p.copy()
         self.n = self.P.n
-        self.period = period
+        self.period = self.P.period  # (None: the system's footfall cycle)
 
     def at(self, lam: float) -> None:
         self.P.p[self.j] = lam

@@ -60,7 +60,7 @@ def continue_branch(
     *,
     params: Mapping[str, float] | None = None,
     guess: Sequence[float] | None = None,
-    period: int = 1,
+    period: int | None = None,
     max_delta: float | None = None,
     max_points: int = 400,
     rtol: float = FIXED_POINT_TOL,
@@ -68,7 +68,8 @@ def continue_branch(
     tol: float = RESIDUAL_TOL,
     locate: bool = True,
 ) -> Branch:
-    """Continue the period-``period`` gait from ``param = start`` towards ``stop``.
+    """Continue the period-``period`` gait from ``param = start`` towards ``stop``; ``period``
+    counts footfalls, by default the system's footfall cycle (as :func:`find_fixed_point`).
 
     The first gait is :func:`find_fixed_point` from ``guess`` (default: the model's) at ``start``.
     The branch is traced by pseudo-arclength until the parameter leaves [start, stop] (the last
@@ -84,7 +85,7 @@ def continue_branch(
         raise StateError(f"continuation needs a finite range START ≠ STOP, got {start}:{stop}")
     prob = _Problem(system, params, param, period, rtol, atol)
     base = {**dict(params or {}), param: start}
-    lc = find_fixed_point(system, guess, params=base, period=period, rtol=rtol, atol=atol, tol=tol)
+    lc = find_fixed_point(system, guess, params=base, period=prob.period, rtol=rtol, atol=atol, tol=tol)
     # a period-k search may land on a period-d orbit (d | k): it is continued as a k-step fixed point
     return _trace(prob, np.r_[lc.fixed_point, start], start, stop, max_delta, max_points, tol, locate,
                   system.name, param, None)
