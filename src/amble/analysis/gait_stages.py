@@ -11,11 +11,12 @@ from ..backend.casadi_export import StepFunctions
 from .gait_result import Gait
 
 
-def period_gait(gaits: list[Gait]) -> Gait:
-    """The gait of a multi-step period: the first step's fields, the period's speed, every step."""
+def period_gait(gaits: list[Gait], modes: list[str] | None = None) -> Gait:
+    """The gait of a multi-step period: the first step's fields, the period's speed, every step
+    (and the mode of each)."""
     T = sum(g.step_time for g in gaits)
     L = sum(g.step_length for g in gaits)
-    return replace(gaits[0], speed=L / T, steps=list(gaits))
+    return replace(gaits[0], speed=L / T, steps=list(gaits), modes=modes)
 
 
 def solve_stages(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, levels: list[int], hzd: bool
