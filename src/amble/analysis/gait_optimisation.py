@@ -40,6 +40,7 @@ import sympy as sp
 from ..backend.cache import fingerprint
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
 from ..errors import ParameterError
+from ..modelling.footfall_cycle import cycle_footfalls
 from ..modelling.hybrid import HybridSystem
 from .collocation import defects, simpson_weights
 from .gait_hzd import bezier_start, virtual_constraints
@@ -73,7 +74,7 @@ def optimize_gait(
     tol: float = 1e-10,
     hzd: bool | None = None,
     progress: bool = False,
-    steps: int = 1,
+    steps: int | None = None,
     step_params: Sequence[Mapping[str, float]] | None = None,
     max_multiplier: float | None = None,
 ) -> Gait:
@@ -122,25 +123,25 @@ def optimize_gait(
     :class:`SolverError` (naming the reason and the most violated constraint) when IPOPT fails.
     """
     ca = casadi_module()
+    footfalls = cycle_footfalls(system)
+    S = _period_length(system, footfalls, steps)
     hzd, bezier_degree = _check_options(system, speed, step_length, mu, step_time, clearance, nodes, hzd,
-                                        bezier_degree, max_iter, steps)
-    _check_stability_option(max_multiplier, hzd, steps)
-    S = steps
+                                        bezier_degree, max_iter, S)
+    _check_stability_option(max_multiplier, hzd, S)
     pvals = _parameters(system, params)
     if step_params is not None and len(step_params) != S:
         raise ParameterError(f"step_params must hold one mapping per step ({S}), got {len(step_params)}")
     pvs = [_parameters(system, {**pvals, **dict(sp_ or {})}) for sp_ in (step_params or [{}] * S)]
-    model = system.modes[system.mode_names[0]]
-    integrand = None if isinstance(objective, str) and objective in OBJECTIVES else _integrand(model, objective)
-    fns = _step_functions(system, integrand, _expression(model, phase, "phase") if phase is not None else None)
+    models, fnss = _period_functions(system, footfalls, S, objective, phase)
+    fns = fnss[0]
     n, nu, d = fns.n, fns.nu, fns.dims
-    Ps = [np.array([pv[k] for k in fns.param_names]) for pv in pvs]
+    Ps = [np.array([pv[k] for k in f.param_names]) for f, pv in zip(fnss, pvs)]
 
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
-    guesses = initial_guess(system, fns, pvals, guess, levels[0], step_time, posture, steps=S)
+    guesses = initial_guess(system, fnss, pvals, guess, levels[0], step_time, posture, steps=S)
     x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
     total_iter, total_time = 0, 0.0
-    sigma = _momentum(fns, x_guesses[0], Ps[0], max_multiplier, hzd and S == 1)
+    sigma = _momentum(fnss[0], x_guesses[0], Ps[0], max_multiplier, hzd and S == 1)
 
     def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
               feasibility: bool = False, refine: bool = True) -> list[Gait]:
@@ -162,6 +163,7 @@ def optimize_gait(
         offset = 0
         for j in range(S):
             Pj, xg, tg, wj = Ps[j], x_guesses[j], t_guesses[j], warms[j] if warms else None
+            fns = fnss[j]
             # MX with each model function mapped over the points: the graph holds one copy of each
             # function, not 2N + 1 inlined ones (building the problem is then independent of N)
             X, A, U = ca.MX.sym(f"x{j}", 2 * n, K), ca.MX.sym(f"a{j}", n, K), ca.MX.sym(f"u{j}", nu, K)
@@ -214,7 +216,7 @@ def optimize_gait(
             Ts.append(Tv)
             Ls.append(L)
             # bounds
-            lbw, ubw = _bounds(model, fns, bounds, N, tg)
+            lbw, ubw = _bounds(models[j], fns, bounds, N, tg)
             if feasibility:
                 # the step time held at the guess's: free, it collapses to its lower bound (standing
                 # still, the defects h·f of a falling robot shrink with h = T/N), where no step fits
@@ -231,7 +233,7 @@ def optimize_gait(
             ws.append(w)
         for j in range(S):  # each footfall leads into the next step (the last into the first)
             qN = Xs[j][:n, -1]
-            add("periodicity", fns.relabel(qN, QEs[j], Ps[j]) - Xs[(j + 1) % S][:, 0])
+            add("periodicity", fnss[j].relabel(qN, QEs[j], Ps[j]) - Xs[(j + 1) % S][:, 0])
         if speed is not None:  # the pace of the whole period
             add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
         J = sum(integrals[1:], integrals[0]) / sum(dists[1:], dists[0])
@@ -268,12 +270,12 @@ def optimize_gait(
         out, start = [], 0
         for j in range(S):
             size = ws[j].numel()
-            out.append(_gait(system, model, fns, pvs[j], wopt[start:start + size], N, objective, float(sol["f"]),
-                             report, dict(info), bezier_degree, hzd))
+            out.append(_gait(system, models[j], fnss[j], pvs[j], wopt[start:start + size], N, objective,
+                             float(sol["f"]), report, dict(info), bezier_degree, hzd))
             start += size
         return out
 
-    stages = solve_stages(fns, x_guesses[0], Ps[0], levels, hzd)
+    stages = solve_stages(fnss[0], x_guesses[0], Ps[0], levels, hzd)
     warms: list[Gait] | None = None
     for N, with_vc, feasible, refine in stages:
         if warms is not None:  # a later stage starts from the previous solution, interpolated
@@ -283,10 +285,40 @@ def optimize_gait(
         total_iter += warms[0].solver["iterations"]
         total_time += warms[0].solver["time_s"]
     assert warms is not None
-    warm = warms[0] if S == 1 else period_gait(warms)
+    warm = warms[0] if S == 1 else period_gait(warms, [footfalls[j % len(footfalls)].source for j in range(S)])
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
     warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
     return warm
+
+
+def _period_functions(system: HybridSystem, footfalls: list, S: int, objective: Any, phase: Any
+                      ) -> tuple[list[Any], list[StepFunctions]]:
+    """Each step's model and exported functions over a period of ``S`` footfalls (a walker whose
+    stance feet are modes alternates its modes; one that relabels its legs repeats its one)."""
+    models = [system.modes[footfalls[j % len(footfalls)].source] for j in range(S)]
+    fnss = [_step_functions(system, None if isinstance(objective, str) and objective in OBJECTIVES
+                            else _integrand(m, objective),
+                            _expression(m, phase, "phase") if phase is not None else None,
+                            footfalls[j % len(footfalls)].name)
+            for j, m in enumerate(models)]
+    if any((f.n, f.nu, f.dims) != (fnss[0].n, fnss[0].nu, fnss[0].dims) for f in fnss):
+        raise ParameterError(f"system {system.name!r}: the modes of a period need the same numbers of coordinates "
+                             "and inputs")
+    return models, fnss
+
+
+def _period_length(system: HybridSystem, footfalls: list, steps: int | None) -> int:
+    """Footfalls per period: ``steps``, by default one cycle of the walker's modes; a
+    :class:`ParameterError` for a number that is not a multiple of the cycle."""
+    if steps is None:
+        return len(footfalls)
+    if not (isinstance(steps, int) and 1 <= steps <= 8):
+        raise ParameterError(f"steps must be an integer in [1, 8], got {steps!r}")
+    if steps % len(footfalls):
+        cycle = " → ".join([*(t.source for t in footfalls), footfalls[0].source])
+        raise ParameterError(f"steps={steps}: a gait of {system.name!r} returns to its first mode after a multiple "
+                             f"of {len(footfalls)} footfalls ({cycle})")
+    return steps
 
 
 def _stability_row(ca: Any, sigma: Any, X: Any, P: np.ndarray, n: int, max_multiplier: float | None) -> Any:
@@ -325,16 +357,17 @@ def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multip
 _EXPORTS: dict[tuple, tuple[Any, StepFunctions]] = {}
 
 
-def _step_functions(system: HybridSystem, integrand: sp.Expr | None, phase: sp.Expr | None) -> StepFunctions:
+def _step_functions(system: HybridSystem, integrand: sp.Expr | None, phase: sp.Expr | None,
+                    transition: str | None = None) -> StepFunctions:
     """:func:`~amble.backend.casadi_export.step_functions`, once per system and declaration:
     any edit of a declaration advances its revision (:func:`amble.backend.cache.fingerprint`),
     which makes a new key."""
     key = (id(system), fingerprint(system), None if integrand is None else sp.srepr(integrand),
-           None if phase is None else sp.srepr(phase))
+           None if phase is None else sp.srepr(phase), transition)
     hit = _EXPORTS.get(key)
     if hit is not None and hit[0]() is system:
         return hit[1]
-    fns = step_functions(system, integrand, phase)
+    fns = step_functions(system, integrand, phase, transition)
     if len(_EXPORTS) >= 32:  # systems made per call would fill it
         _EXPORTS.clear()
     _EXPORTS[key] = (weakref.ref(system), fns)

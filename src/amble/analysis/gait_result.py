@@ -63,6 +63,9 @@ class Gait:
     #: fields above are then the first step's, except ``speed`` (the period's: Σ L / Σ T) and
     #: ``objective`` (the period's). None for a one-step gait
     steps: list[Gait] | None = None
+    #: the mode of each step of a multi-step period (a walker whose stance feet are modes:
+    #: ``["left", "right"]``); None for one step
+    modes: list[str] | None = None
     #: an HZD gait's stability (:mod:`~amble.analysis.gait_stability`): ``restricted_multiplier``
     #: (``δ_zero²``, the multiplier of the restricted Poincaré map), ``max_multiplier`` (its bound
     #: in the optimisation, or None) and, once checked, ``closed_loop`` (the full-order multipliers
@@ -130,6 +133,7 @@ class Gait:
             "constraints": self.constraints, "max_violation": self.max_violation,
             "bezier": self.bezier, "stability": self.stability, "solver": self.solver,
             **({"period": len(self.steps), "steps": [_step_json(g) for g in self.steps]} if self.steps else {}),
+            **({"modes": self.modes} if self.modes else {}),
         }
 
     def save(self, path: str | Path) -> Path:

@@ -11,11 +11,28 @@ from ..backend.casadi_export import StepFunctions
 from .gait_result import Gait
 
 
-def period_gait(gaits: list[Gait]) -> Gait:
-    """The gait of a multi-step period: the first step's fields, the period's speed, every step."""
+def period_gait(gaits: list[Gait], modes: list[str] | None = None) -> Gait:
+    """The gait of a multi-step period: the first step's fields, the period's speed, every step
+    (and the mode of each)."""
     T = sum(g.step_time for g in gaits)
     L = sum(g.step_length for g in gaits)
-    return replace(gaits[0], speed=L / T, steps=list(gaits))
+    return replace(gaits[0], speed=L / T, steps=list(gaits), modes=modes, bezier=_period_bezier(gaits))
+
+
+def _period_bezier(gaits: list[Gait]) -> dict | None:
+    """The first step's virtual constraints, with the controller parameters of every step where
+    the steps name them apart (each stance mode its own coefficients) or agree on them: the
+    values that run the whole period in ``simulate``."""
+    first = gaits[0].bezier
+    if not first or "params" not in first or not all(g.bezier and "params" in g.bezier for g in gaits):
+        return first
+    merged: dict[str, float] = {}
+    for g in gaits:
+        for k, v in g.bezier["params"].items():
+            if k in merged and abs(merged[k] - v) > 1e-9 * max(1.0, abs(v)):
+                return first  # one mode's coefficients differ from step to step: no single controller
+            merged[k] = v
+    return {**first, "params": merged}
 
 
 def solve_stages(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, levels: list[int], hzd: bool

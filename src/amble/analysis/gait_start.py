@@ -20,8 +20,9 @@ GUESSES = ("passive", "stand", "interpolate")
 SETTLE_STEPS = 30
 
 
-def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, float], guess: Any, N: int,
-                  step_time: float | None, posture: Any = None, steps: int = 1) -> list[tuple[np.ndarray, float]]:
+def initial_guess(system: HybridSystem, fns: StepFunctions | list[StepFunctions], params: dict[str, float],
+                  guess: Any, N: int, step_time: float | None, posture: Any = None, steps: int = 1
+                  ) -> list[tuple[np.ndarray, float]]:
     """Per step of the period (``steps`` of them), the states at the ``2N + 1`` collocation points
     and the step time (s) to start from.
 
@@ -38,7 +39,14 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
     passive step that does not end in a footfall falls back to ``"interpolate"``. ``step_time``
     (s) is the duration of the last two; ``posture`` (the ``n`` coordinates, rad or m) replaces the
     guess's posture in them.
+
+    ``fns``: the step's exported functions, or one per step of the period (a walker whose stance
+    feet are modes): a standing or interpolated start then takes the same numbers in every mode,
+    coordinate by coordinate — the stance leg's joints in the stance leg's places — which is the
+    same posture for a walker whose modes list their legs in the same order.
     """
+    fnss = list(fns) if isinstance(fns, (list, tuple)) else [fns] * steps
+    fns = fnss[0]
     K, n = 2 * N + 1, fns.n
     if isinstance(guess, str) and guess not in GUESSES:
         raise ParameterError(f"guess must be one of {', '.join(GUESSES)} or a state, got {guess!r}")
@@ -80,10 +88,13 @@ def initial_guess(system: HybridSystem, fns: StepFunctions, params: dict[str, fl
     if kind == "stand":
         return [(np.tile(np.concatenate([q0, np.zeros(n)]), (K, 1)), T)] * steps
     # the relabelling of a footfall swaps legs, so (as an involution) it maps the first posture to the last
-    P = np.array([params[k] for k in fns.param_names])
-    qN = np.asarray(fns.relabel(q0, np.zeros(n + fns.dims), P), float).ravel()[:n]
     s = np.linspace(0.0, 1.0, K)[:, None]
-    return [(np.hstack([(1 - s) * q0 + s * qN, np.tile((qN - q0) / T, (K, 1))]), T)] * steps
+    out = []
+    for f in fnss[:steps]:
+        P = np.array([params[k] for k in f.param_names])
+        qN = np.asarray(f.relabel(q0, np.zeros(n + f.dims), P), float).ravel()[:n]
+        out.append((np.hstack([(1 - s) * q0 + s * qN, np.tile((qN - q0) / T, (K, 1))]), T))
+    return out
 
 
 def default_guess_kind(system: HybridSystem) -> str:

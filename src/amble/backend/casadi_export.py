@@ -235,9 +235,13 @@ def _conditions(cond: Any) -> list[sp.Expr]:
     raise ModelError(f"enabling condition {c} is not a comparison (or a conjunction of comparisons)")
 
 
-def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> StepFunctions:
-    """Export one step of a one-mode walker (:class:`~amble.modelling.walker.Walker`) whose footfall
-    is an :class:`~amble.modelling.hybrid.Impact` back into the same mode.
+def step_functions(system: Any, integrand: Any = None, phase: Any = None, transition: str | None = None
+                   ) -> StepFunctions:
+    """Export one step of a walker (:class:`~amble.modelling.walker.Walker`): a stance in one mode
+    ended by a footfall ``transition`` (an :class:`~amble.modelling.hybrid.Impact`) into the next
+    step's mode — the same mode for a walker that relabels its legs, the other stance foot's for a
+    walker whose stance feet are modes. ``transition`` (its name) may be omitted for a one-mode
+    walker with one footfall. ``relabel`` gives the state in the target mode's coordinates.
 
     ``integrand``: an optional sympy expression in the state, the inputs and the parameters,
     exported as ``integrand(q, qd, u, t, p)``. ``phase``: an expression of the coordinates that
@@ -253,16 +257,11 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     from ..modelling.model import t as time
 
     ca = casadi_module()
-    modes = list(system.modes)
-    steps = [tr for tr in system.transitions if tr.step]
-    if len(modes) != 1 or len(steps) != 1 or steps[0].source != steps[0].target:
-        raise ModelError(f"system {system.name!r}: gait optimisation needs one mode and one footfall back into it "
-                         f"(it has modes {modes} and {len(steps)} footfall transition(s))")
-    tr = steps[0]
+    tr = _footfall(system, transition)
     if tr.reset is None or tr.reset.impact_point is None:
         raise ModelError(f"system {system.name!r}: the footfall {tr.name!r} must be an Impact (derived) reset, "
                          f"not {type(tr.reset).__name__}")
-    m = system.modes[modes[0]]
+    m, target = system.modes[tr.source], system.modes[tr.target]
     refuse_constrained(m, "gait optimisation")
     eq = derive(m, control=False)  # the inputs are unknowns of the problem: no feedback law
     n, d = len(m.q), m.dims
@@ -296,7 +295,7 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     acc = ca.jtimes(vel, q, qd) + ca.jtimes(vel, qd, a)
     force = acc - T(mt) * T.matrix(m.gravity_vector)
     contact = ca.Function("contact", [q, qd, a, p], [force], ["q", "qd", "a", "p"], ["force"])
-    imp = impulse_data(m, eq, tr.reset, m, f"reset of transition {tr.name!r}")
+    imp = impulse_data(m, eq, tr.reset, target, f"reset of transition {tr.name!r}")
     Me, Jc = T.matrix(imp.Me), T.matrix(imp.Jc)
     pre = ca.vertcat(qd, ca.SX.zeros(d))
     impact = ca.Function("impact", [q, qd, qe, lam, p], [ca.vertcat(Me @ (qe - pre) - Jc.T @ lam, Jc @ qe)],
@@ -338,6 +337,28 @@ def step_functions(system: Any, integrand: Any = None, phase: Any = None) -> Ste
     return StepFunctions(n, nu, d, m.state_names, [str(s) for s in inputs], pnames, weight, dynamics, contact,
                          impact, relabel, guard, enabled, distance, normal, rates, input_matrix, phase_fn,
                          sp.sstr(phase), f_int, outputs, _output_texts(vc, B, m.q), virtual)
+
+
+def _footfall(system: Any, name: str | None) -> Any:
+    """The footfall transition of one step: ``name``'s, or a one-mode walker's only one; a
+    :class:`ModelError` for a step that passes through other modes (a knee locking: one domain per
+    step only) or a footfall that is not a step transition."""
+    steps = [tr for tr in system.transitions if tr.step]
+    if name is None:
+        if len(system.modes) != 1 or len(steps) != 1:
+            raise ModelError(f"system {system.name!r}: name the footfall transition of the step (modes "
+                             f"{list(system.modes)}, footfall transitions {[tr.name for tr in steps]})")
+        return steps[0]
+    tr = next((t for t in steps if t.name == name), None)
+    if tr is None:
+        raise ModelError(f"system {system.name!r}: no footfall transition {name!r} (footfall transitions: "
+                         f"{', '.join(t.name for t in steps) or 'none'})")
+    others = [t.name for t in system.transitions
+              if t.source == tr.source and not t.step and t.terminal is None and not t.forced]
+    if others:
+        raise ModelError(f"system {system.name!r}: gait optimisation needs one domain per step; mode "
+                         f"{tr.source!r} also leaves by {', '.join(others)} before its footfall")
+    return tr
 
 
 def _output_texts(vc: Any, B: sp.Matrix, q: list) -> list[str]:

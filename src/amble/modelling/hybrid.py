@@ -258,6 +258,13 @@ class HybridSystem(Revised):
                 return u
         return ""
 
+    def footfall_cycle(self, mode: str | None = None) -> list[str] | None:
+        """The section modes of one cycle of footfalls from ``mode`` (default the first), or None
+        where it is not unique (:func:`amble.modelling.footfall_cycle.footfall_cycle`)."""
+        from .footfall_cycle import footfall_cycle
+
+        return footfall_cycle(self, mode)
+
     def frame_change(self, transition: str) -> tuple[str | None, tuple[float, float, float]]:
         """How a transition re-expresses positions: the point whose pre-event position becomes the
         new origin (or ``None``) and the diagonal of the axis reflection (world-frame kinematics
