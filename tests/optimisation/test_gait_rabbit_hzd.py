@@ -120,10 +120,8 @@ def test_rabbit_hzd_gait_walks_in_closed_loop():
 
 
 def test_rabbit_hzd_gait_from_the_interpolated_start():
-    """The interpolated start (posture to its relabelling) still gives a feasible HZD gait (no
-    feasibility solve: it moves)."""
+    """The interpolated start (posture to its relabelling) still gives a feasible HZD gait."""
     s = rabbit.build()
     g = optimize_gait(s, speed=SPEED, nodes=10, guess="interpolate", step_time=0.4)
-    assert g.solver["iterations_total"] == g.solver["iterations"]
     assert g.max_violation <= 1e-8 and g.speed == pytest.approx(SPEED, rel=1e-9)
     assert np.abs(_outputs_on_gait(s, g)).max() <= 1e-8

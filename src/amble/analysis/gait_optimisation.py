@@ -53,6 +53,11 @@ from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
 
 OBJECTIVES = ("effort", "cot")
+#: a step whose equations of motion and contact force take more CasADi instructions than this is
+#: solved on the problem expanded to scalar operations (``expand``): a 9-coordinate 3D tree biped
+#: (7850) then takes 5.9 s of IPOPT instead of 24 s, paying 8 s to expand; RABBIT (860) would
+#: pay more to expand (0.3 s more per design) than it saves
+EXPAND_SIZE = 4000
 
 def optimize_gait(
     system: HybridSystem,
@@ -140,7 +145,6 @@ def optimize_gait(
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
     guesses = initial_guess(system, fnss, pvals, guess, levels[0], step_time, posture, steps=S)
     x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
-    total_iter, total_time = 0, 0.0
     sigma = _momentum(fnss[0], x_guesses[0], Ps[0], max_multiplier, hzd and S == 1)
 
     def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
@@ -255,7 +259,8 @@ def optimize_gait(
 
         opts = {"ipopt.tol": tol, "ipopt.constr_viol_tol": min(tol, 1e-10), "ipopt.max_iter": max_iter,
                 "ipopt.print_level": 5 if progress else 0, "print_time": False, "ipopt.sb": "yes",
-                "ipopt.mu_strategy": "adaptive"}
+                "ipopt.mu_strategy": "adaptive",
+                "expand": fnss[0].dynamics.n_instructions() + fnss[0].contact.n_instructions() > EXPAND_SIZE}
         if warms is not None and refine:
             # a finer mesh starts next to the coarse optimum: a small barrier parameter and a start
             # kept where it is (not pushed into the interior) take a handful of iterations instead
@@ -276,19 +281,28 @@ def optimize_gait(
         return out
 
     stages = solve_stages(fnss[0], x_guesses[0], Ps[0], levels, hzd)
+    warms, total_iter, total_time = _run_stages(solve, stages, x_guesses, t_guesses)
+    warm = warms[0] if S == 1 else period_gait(warms, [footfalls[j % len(footfalls)].source for j in range(S)])
+    warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
+    warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
+    return warm
+
+
+def _run_stages(solve: Any, stages: list[tuple[int, bool, bool, bool]], x_guesses: list[np.ndarray],
+                t_guesses: list[float]) -> tuple[list[Gait], int, float]:
+    """The solves of :func:`~amble.analysis.gait_stages.solve_stages` in turn, each from the
+    previous solution: the gaits of the last, the iterations and the solver's seconds of all."""
     warms: list[Gait] | None = None
+    iters, secs = 0, 0.0
     for N, with_vc, feasible, refine in stages:
         if warms is not None:  # a later stage starts from the previous solution, interpolated
             x_guesses = [wg.state(np.linspace(0.0, wg.step_time, 2 * N + 1)) for wg in warms]
             t_guesses = [wg.step_time for wg in warms]
         warms = solve(N, x_guesses, t_guesses, warms, with_vc, feasible, refine)
-        total_iter += warms[0].solver["iterations"]
-        total_time += warms[0].solver["time_s"]
+        iters += warms[0].solver["iterations"]
+        secs += warms[0].solver["time_s"]
     assert warms is not None
-    warm = warms[0] if S == 1 else period_gait(warms, [footfalls[j % len(footfalls)].source for j in range(S)])
-    warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
-    warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
-    return warm
+    return warms, iters, secs
 
 
 def _period_functions(system: HybridSystem, footfalls: list, S: int, objective: Any, phase: Any
