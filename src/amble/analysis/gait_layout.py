@@ -46,7 +46,8 @@ def _bound_groups(fns: StepFunctions, N: int) -> list[tuple[str, int, int]]:
 
 
 def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: np.ndarray, N: int,
-          objective: Any, value: float, report: dict, solver: dict, degree: int, hzd: bool = False) -> Gait:
+          objective: Any, value: float, report: dict, solver: dict, degree: int, alpha: np.ndarray | None = None
+          ) -> Gait:
     n, nu, K = fns.n, fns.nu, 2 * N + 1
     X = w[: 2 * n * K].reshape(K, 2 * n)
     A = w[2 * n * K: 3 * n * K].reshape(K, n)
@@ -54,9 +55,8 @@ def _gait(system: HybridSystem, model: Any, fns: StepFunctions, pvals: dict, w: 
     T = float(w[(3 * n + nu) * K])
     base = (3 * n + nu) * K + 1
     qe, impulse = w[base: base + n + fns.dims], w[base + n + fns.dims: base + n + 2 * fns.dims]
-    # an HZD gait's coefficients are the last unknowns (column-major nu × (M+1)): exported as
-    # optimised, not refitted, so the controller holds exactly the polynomial of the collocation
-    alpha = w[len(w) - nu * (degree + 1):].reshape(degree + 1, nu).T if hzd and nu else None
+    # an HZD gait's coefficients (``alpha``, nu × (M+1)) are exported as optimised, not refitted,
+    # so the controller holds exactly the polynomial of the collocation
     P = np.array([pvals[k] for k in fns.param_names])
     L = float(fns.distance(X[-1, :n], P))
     forces = np.array([np.asarray(fns.contact(x[:n], x[n:], a, P), float).ravel() for x, a in zip(X, A)])

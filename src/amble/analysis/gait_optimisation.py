@@ -165,6 +165,11 @@ def optimize_gait(
         Xs, QEs, Ts, integrals, dists, Ls = [], [], [], [], [], []
         wts = ca.DM(simpson_weights(N))
         offset = 0
+        # the Bézier coefficients of steps whose modes name them alike (a walker whose stance
+        # feet are modes with one mirrored controller) are one set of unknowns, with one phase
+        # range: the parameters the controller runs on have one value
+        owners: dict[tuple, tuple[int, Any]] = {}
+        alpha_at: list[tuple[int, int]] = []  # per step: where its coefficients are in the unknowns
         for j in range(S):
             Pj, xg, tg, wj = Ps[j], x_guesses[j], t_guesses[j], warms[j] if warms else None
             fns = fnss[j]
@@ -173,8 +178,11 @@ def optimize_gait(
             X, A, U = ca.MX.sym(f"x{j}", 2 * n, K), ca.MX.sym(f"a{j}", n, K), ca.MX.sym(f"u{j}", nu, K)
             Tv, QE, LAM = ca.MX.sym(f"T{j}"), ca.MX.sym(f"qe{j}", n + d), ca.MX.sym(f"lam{j}", d)
             PW = ca.MX.sym(f"power{j}", 2 * nu if cot else 0, K)  # positive and negative parts of each power
-            AL = ca.MX.sym(f"alpha{j}", nu if hzd else 0, Mb + 1)  # Bézier coefficients of the virtual constraints
-            w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(AL))
+            key = _controller_key(fns) if hzd else None
+            owner = owners.get(key) if key is not None else None
+            AL = ca.MX.sym(f"alpha{j}", nu if hzd else 0, Mb + 1) if owner is None else owner[1]
+            ALw = AL if owner is None else ca.MX(0, 1)  # in this step's unknowns, or in the owner's
+            w = ca.vertcat(ca.vec(X), ca.vec(A), ca.vec(U), Tv, QE, LAM, ca.vec(PW), ca.vec(ALw))
             h = Tv / N
             taus = ca.DM(np.arange(K)[None, :] / 2.0) * h
             Q, V = X[:n, :], X[n:, :]
@@ -204,6 +212,10 @@ def optimize_gait(
                 add("clearance", lift - ca.DM(clearance * 4 * s_ * (1 - s_))[:, 0].T, 0.0, np.inf)
             if hzd:
                 add("virtual_constraints", virtual_constraints(fns, X, Pj, xg, AL))
+                if owner is not None:  # the same phase range as the step that owns the coefficients
+                    X0, f0, P0 = Xs[owner[0]], fnss[owner[0]], Ps[owner[0]]
+                    add("shared_phase", ca.vertcat(fns.phase(X[:n, 0], Pj) - f0.phase(X0[:n, 0], P0),
+                                                   fns.phase(X[:n, -1], Pj) - f0.phase(X0[:n, -1], P0)))
                 add("stability", _stability_row(ca, sigma, X, Pj, n, max_multiplier), -np.inf,
                     max_multiplier or 1.0)
             if cot:  # |power| = its positive plus its negative part, each ≥ 0
@@ -226,10 +238,15 @@ def optimize_gait(
                 # still, the defects h·f of a falling robot shrink with h = T/N), where no step fits
                 it = (3 * n + nu) * K
                 lbw[it] = ubw[it] = tg
-            lbws.append(np.concatenate([lbw, np.zeros(PW.numel()), np.full(AL.numel(), -np.inf)]))
-            ubws.append(np.concatenate([ubw, np.full(PW.numel() + AL.numel(), np.inf)]))
+            lbws.append(np.concatenate([lbw, np.zeros(PW.numel()), np.full(ALw.numel(), -np.inf)]))
+            ubws.append(np.concatenate([ubw, np.full(PW.numel() + ALw.numel(), np.inf)]))
             alpha0 = (np.array(wj.bezier["alpha"]) if hzd and wj is not None and wj.bezier
                       else bezier_start(fns, xg, Pj, Mb) if hzd else np.zeros(0))
+            alpha0 = alpha0 if owner is None else np.zeros(0)
+            if owner is None and key is not None:
+                owners[key] = (j, AL)
+            alpha_at.append((offset + w.numel() - AL.numel(), offset + w.numel()) if owner is None
+                            else alpha_at[owner[0]])
             w0s.append(np.concatenate([start_vector(fns, xg, tg, N, Pj, wj), np.zeros(PW.numel()),
                                        alpha0.ravel(order="F")]))
             bound_groups += [(name, offset + lo, offset + hi) for name, lo, hi in _bound_groups(fns, N)]
@@ -275,8 +292,10 @@ def optimize_gait(
         out, start = [], 0
         for j in range(S):
             size = ws[j].numel()
+            a, b = alpha_at[j]
+            alpha = wopt[a:b].reshape(bezier_degree + 1, nu).T if hzd and nu else None
             out.append(_gait(system, models[j], fnss[j], pvs[j], wopt[start:start + size], N, objective,
-                             float(sol["f"]), report, dict(info), bezier_degree, hzd))
+                             float(sol["f"]), report, dict(info), bezier_degree, alpha))
             start += size
         return out
 
@@ -286,6 +305,15 @@ def optimize_gait(
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
     warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
     return warm
+
+
+def _controller_key(fns: StepFunctions) -> tuple | None:
+    """The parameter names of a step's own virtual constraints (its Bézier coefficients and phase
+    range), or None without them."""
+    vc = fns.virtual
+    if vc is None:
+        return None
+    return (*(k for row in vc["alpha"] for k in row), vc["phase_start"], vc["phase_end"])
 
 
 def _run_stages(solve: Any, stages: list[tuple[int, bool, bool, bool]], x_guesses: list[np.ndarray],
