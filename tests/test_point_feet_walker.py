@@ -214,3 +214,32 @@ def test_load_walker_on_a_small_biped_mirrors_its_roll_joints(biped6):
     planar = load_walker(biped6, soles, pivot=(0, 1, 0))
     assert [str(q) for q in planar.modes["left"].q][0] == "stance"
     assert all(a.limit == 1.0 for a in planar.modes["left"].actuators)   # the file's effort
+
+
+@pytest.mark.slow
+def test_bolt_virtual_constraints_drive_the_outputs_as_their_closed_form():
+    """With constant desired outputs (every Bézier coefficient of an output equal: a posture) the
+    input–output linearising law makes each output ``y = h₀(q) − h_d`` obey
+    ``ÿ = −kd ẏ/ε − kp y/ε²``; with ``kp = 1``, ``kd = 2`` and ``ẏ(0) = 0`` that is
+    ``y(t) = y(0) (1 + t/ε) e^(−t/ε)`` — on Bolt's compiled right-stance mode, whose outputs carry
+    the mirror signs."""
+    posture = [0.1, 0.3, -0.6, -0.05, 0.3, -0.6]   # rad: stance leg, then swing leg (HAA, HFE, KFE)
+    eps = 0.02
+    w = load_walker(_bolt_urdf(), FEET, max_step_time=1.0,
+                    virtual=VirtualOutputs(degree=3, alpha=[[v] * 4 for v in posture], epsilon=eps))
+    R = w.modes["right"]
+    names = [str(s) for s in R.q]
+    n = len(names)
+    start = {"FR_HAA": 0.05, "FR_HFE": 0.35, "FR_KFE": -0.5, "FL_HAA": -0.1, "FL_HFE": 0.2, "FL_KFE": -0.7}
+    x0 = np.zeros(2 * n)
+    for name, v in start.items():
+        x0[names.index(name)] = v
+    traj = simulate(w, mode="right", x0=x0, t_end=0.06, rtol=1e-11, atol=1e-11)
+    assert not traj.step_events
+    outputs = [(-1.0, "FR_HAA"), (1.0, "FR_HFE"), (1.0, "FR_KFE"), (-1.0, "FL_HAA"), (1.0, "FL_HFE"),
+               (1.0, "FL_KFE")]
+    tau = traj.t / eps
+    for (s, name), target in zip(outputs, posture):
+        y = s * traj.column(name) - target
+        expected = (s * start[name] - target) * (1 + tau) * np.exp(-tau)
+        assert np.abs(y - expected).max() <= 1e-9, name
