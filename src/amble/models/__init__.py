@@ -262,6 +262,32 @@ def load_robot(path: str | os.PathLike, base: str | None = None, fixed_base: boo
     return system
 
 
+def load_walker(path: str | os.PathLike, feet: Any, **options: Any) -> Any:
+    """A point-foot walker of the URDF at ``path``: the file loaded once per stance foot, each
+    rooted at that foot and pivoting at its contact point, every other moving joint actuated
+    (bounded by the file's ``effort``), the footfalls derived (plastic impacts of the contact
+    points). ``feet``: ``{mode: (link, (x, y, z))}``, e.g. Bolt's
+    ``{"left": ("FL_FOOT", (0, 0, -0.016)), "right": ("FR_FOOT", (0, 0, -0.016))}``; ``options``:
+    ``hip``, ``pivot`` (``"spherical"`` or a revolute axis), ``slope``, ``name``,
+    ``max_step_time``, ``virtual`` (:class:`~amble.modelling.point_feet.VirtualOutputs`: virtual
+    constraints on the joints), ``parameters`` — see
+    :func:`amble.modelling.point_feet.point_foot_walker`."""
+    from ..modelling.point_feet import point_foot_walker
+
+    text = os.fspath(path)
+    if Path(text).suffix.lower() != ".urdf":
+        raise ModelError(f"{text}: a walker is made from a URDF file")
+    return point_foot_walker(text, feet, **options)
+
+
+def __getattr__(name: str) -> Any:
+    if name == "VirtualOutputs":  # with SymPy: imported when asked for, as the package root does
+        from ..modelling.point_feet import VirtualOutputs
+
+        return VirtualOutputs
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 def is_file_spec(spec: str) -> bool:
     """Whether ``spec`` names a model file (``….py`` or ``….py:callable``) rather than a library model."""
     path, _, _ = _split_spec(spec)
