@@ -17,9 +17,9 @@ pytest.importorskip("casadi")
 
 sys.path.insert(0, str(Path(__file__).parents[1]))
 
-from two_mode_walkers import compass_two_modes, rabbit_stance, rabbit_two_modes  # noqa: E402
+from two_mode_walkers import compass_two_modes, compass_two_modes_hzd, rabbit_stance, rabbit_two_modes  # noqa: E402
 
-from amble import walker  # noqa: E402
+from amble import closed_loop_stability, simulate, walker  # noqa: E402
 from amble.analysis.gait_optimisation import optimize_gait  # noqa: E402
 from amble.errors import ModelError, ParameterError  # noqa: E402
 from amble.models import load  # noqa: E402
@@ -73,3 +73,24 @@ def test_rabbit_as_two_stance_modes_has_the_optimum_of_rabbit_with_legs_swapped_
     np.testing.assert_allclose(a.fixed_point, b.fixed_point, rtol=0, atol=1e-8)
     np.testing.assert_allclose([s.step_time for s in a.steps], [s.step_time for s in b.steps], rtol=1e-8)
     assert a.speed == pytest.approx(0.8, rel=1e-9)
+
+
+@pytest.mark.parametrize("bound", [None, 0.3])
+def test_a_two_mode_hzd_gait_walks_in_closed_loop_with_the_restricted_maps_multiplier(bound):
+    w = compass_two_modes_hzd()
+    g = optimize_gait(w, nodes=20, speed=0.6, guess="interpolate", step_time=0.7, max_multiplier=bound)
+    assert g.max_violation <= 1e-9 and g.modes == ["left", "right"]
+    assert g.steps[0].bezier["alpha"] == g.steps[1].bezier["alpha"]  # one controller for both stances
+    params = {**g.params, **g.bezier["params"]}
+    walk = simulate(w, x0=g.fixed_point, params=params, steps=20, t_end=60.0)
+    assert walk.status == "completed" and len(walk.step_events) == 20
+    assert [e.source for e in walk.step_events[:2]] == ["left", "right"]
+    mu = g.stability["restricted_multiplier"]
+    if bound is None:
+        assert 0.3 < mu < 1.0  # the free optimum is stable, and above the bound tried next
+    else:
+        assert mu == pytest.approx(bound, rel=1e-8)  # the bound binds
+    loop = closed_loop_stability(w, g)
+    assert loop["residual"] <= 1e-10 and loop["fixed_point_distance"] <= 2e-4  # the collocation's error
+    assert loop["spectral_radius"] == pytest.approx(mu, rel=1e-8)
+    assert abs(complex(*loop["multipliers"][1])) <= 1e-9  # transverse to the zero dynamics: ε small

@@ -48,7 +48,7 @@ from .gait_ipopt import _solve_nlp
 from .gait_layout import _bound_groups, _bounds, _gait
 from .gait_options import _check_options, _check_stability_option, _expression, _integrand, _parameters
 from .gait_result import Gait
-from .gait_stability import momentum_function, restricted_multiplier
+from .gait_stability import momentum_function, period_multiplier
 from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
 
@@ -145,7 +145,7 @@ def optimize_gait(
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
     guesses = initial_guess(system, fnss, pvals, guess, levels[0], step_time, posture, steps=S)
     x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
-    sigma = _momentum(fnss[0], x_guesses[0], Ps[0], max_multiplier, hzd and S == 1)
+    sigmas = _momenta(fnss, x_guesses, Ps, max_multiplier, hzd)
 
     def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
               feasibility: bool = False, refine: bool = True) -> list[Gait]:
@@ -216,8 +216,6 @@ def optimize_gait(
                     X0, f0, P0 = Xs[owner[0]], fnss[owner[0]], Ps[owner[0]]
                     add("shared_phase", ca.vertcat(fns.phase(X[:n, 0], Pj) - f0.phase(X0[:n, 0], P0),
                                                    fns.phase(X[:n, -1], Pj) - f0.phase(X0[:n, -1], P0)))
-                add("stability", _stability_row(ca, sigma, X, Pj, n, max_multiplier), -np.inf,
-                    max_multiplier or 1.0)
             if cot:  # |power| = its positive plus its negative part, each ≥ 0
                 add("power", U * fns.actuator_rates.map(K)(Q, V, Pj) - (PW[:nu, :] - PW[nu:, :]))
             run, scale = _running_cost(ca, fns, objective, U, PW, Q, V, taus, Pj)
@@ -255,8 +253,7 @@ def optimize_gait(
         for j in range(S):  # each footfall leads into the next step (the last into the first)
             qN = Xs[j][:n, -1]
             add("periodicity", fnss[j].relabel(qN, QEs[j], Ps[j]) - Xs[(j + 1) % S][:, 0])
-        if speed is not None:  # the pace of the whole period
-            add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
+        _period_rows(add, Xs, Ls, Ts, sigmas if hzd else None, Ps, n, speed, max_multiplier)
         J = sum(integrals[1:], integrals[0]) / sum(dists[1:], dists[0])
         if feasibility:
             # a first solve from a start without motion looks for any step (no objective): see gait_stages.solve_stages
@@ -303,7 +300,7 @@ def optimize_gait(
     warms, total_iter, total_time = _run_stages(solve, stages, x_guesses, t_guesses)
     warm = warms[0] if S == 1 else period_gait(warms, [footfalls[j % len(footfalls)].source for j in range(S)])
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
-    warm.stability = _stability_report(sigma, warm, Ps[0], n, max_multiplier)
+    warm.stability = _stability_report(sigmas, warms, Ps, n, max_multiplier)
     return warm
 
 
@@ -363,30 +360,35 @@ def _period_length(system: HybridSystem, footfalls: list, steps: int | None) -> 
     return steps
 
 
-def _stability_row(ca: Any, sigma: Any, X: Any, P: np.ndarray, n: int, max_multiplier: float | None) -> Any:
-    """The bounded multiplier ``δ_zero²`` of a step whose first and last points lie on ``Z`` (exact
-    there, see :mod:`~amble.analysis.gait_stability`), or nothing without a bound."""
-    if max_multiplier is None:
-        return ca.MX(0, 1)
-    return restricted_multiplier(sigma, X[:, 0], X[:, -1], P, n)
+def _period_rows(add: Any, Xs: list[Any], Ls: list[Any], Ts: list[Any], sigmas: list[Any] | None,
+                 Ps: list[np.ndarray], n: int, speed: float | None, max_multiplier: float | None) -> None:
+    """The constraints on a whole period: its pace, and the bound on the restricted Poincaré
+    map's multiplier over it (on a solve with the virtual constraints, ``sigmas`` given)."""
+    if max_multiplier is not None and sigmas is not None:
+        add("stability", period_multiplier(sigmas, [X[:, 0] for X in Xs], [X[:, -1] for X in Xs], Ps, n),
+            -np.inf, max_multiplier)
+    if speed is not None:
+        add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
 
 
-def _stability_report(sigma: Any, gait: Gait, P: np.ndarray, n: int, max_multiplier: float | None
-                      ) -> dict[str, Any] | None:
-    if sigma is None:
+def _stability_report(sigmas: list[Any] | None, gaits: list[Gait], Ps: list[np.ndarray], n: int,
+                      max_multiplier: float | None) -> dict[str, Any] | None:
+    if sigmas is None:
         return None
-    value = float(restricted_multiplier(sigma, gait.fixed_point, gait.pre_impact_state, P, n))
+    value = float(period_multiplier(sigmas, [g.fixed_point for g in gaits], [g.pre_impact_state for g in gaits],
+                                    Ps, n))
     return {"restricted_multiplier": value, "max_multiplier": max_multiplier}
 
 
-def _momentum(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray, max_multiplier: float | None,
-              wanted: bool) -> Any:
-    """The zero dynamics' momentum σ (:func:`~amble.analysis.gait_stability.momentum_function`)
-    of a one-step HZD gait (``wanted``), or None where it does not exist and no bound asks for it."""
+def _momenta(fnss: list[StepFunctions], x_guesses: list[np.ndarray], Ps: list[np.ndarray],
+             max_multiplier: float | None, wanted: bool) -> list[Any] | None:
+    """The zero dynamics' momentum σ of each step of an HZD gait (``wanted``;
+    :func:`~amble.analysis.gait_stability.momentum_function`), or None where it does not exist and
+    no bound asks for it."""
     if not wanted:
         return None
     try:
-        return momentum_function(fns, x_guess, P)
+        return [momentum_function(f, x, P) for f, x, P in zip(fnss, x_guesses, Ps)]
     except ParameterError:
         if max_multiplier is not None:
             raise

@@ -52,8 +52,6 @@ def _check_stability_option(max_multiplier: float | None, hzd: bool, steps: int)
     if not hzd:
         raise ParameterError("max_multiplier bounds the restricted Poincaré map of the hybrid zero dynamics: it "
                              "needs hzd=True (virtual constraints)")
-    if steps != 1:
-        raise ParameterError(f"max_multiplier is for one-step gaits (steps=1), got steps={steps}")
 
 
 def _parameters(system: HybridSystem, params: Mapping[str, float] | None) -> dict[str, float]:

@@ -79,6 +79,20 @@ def momentum_function(fns: StepFunctions, x_guess: np.ndarray, P: np.ndarray) ->
     return ca.Function("sigma", [q, v, p], [sigma], ["q", "qd", "p"], ["sigma"])
 
 
+def period_multiplier(sigmas: list[Any], starts: list[Any], ends: list[Any], Ps: list[Any], n: int) -> Any:
+    """The restricted Poincaré map's multiplier over a period of steps ``j`` (each from
+    ``starts[j]`` to ``ends[j]``, its zero dynamics' momentum ``sigmas[j]``): the product of each
+    footfall's ``δ_j² = (σ_{j+1}(x⁺_{j+1})/σ_j(x⁻_j))²`` — the map of a period is the composition
+    of the steps' maps ``ζ ↦ δ_j² ζ − V_j``, each impact taking the momentum of one mode's zero
+    dynamics to the next's (two stance modes: left, then right). One step: ``δ_zero²``."""
+    S = len(sigmas)
+    out = 1.0
+    for j in range(S):
+        k = (j + 1) % S
+        out = out * (sigmas[k](starts[k][:n], starts[k][n:], Ps[k]) / sigmas[j](ends[j][:n], ends[j][n:], Ps[j])) ** 2
+    return out
+
+
 def restricted_multiplier(sigma: Any, x_post: Any, x_pre: Any, P: Any, n: int) -> Any:
     """``δ_zero² = (σ(x⁺)/σ(x⁻))²`` of a step from ``x_post`` to ``x_pre`` (CasADi expressions;
     with NumPy states a CasADi ``DM``)."""
