@@ -66,7 +66,7 @@ def cmd_optimize_gait(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--bezier-degree must be in [1, 20], got {args.bezier_degree}")
     if args.max_iter < 1:
         raise UsageError(f"--max-iter must be at least 1, got {args.max_iter}")
-    if not 1 <= args.steps <= 8:
+    if args.steps is not None and not 1 <= args.steps <= 8:
         raise UsageError(f"--steps must be in [1, 8], got {args.steps}")
     if args.max_multiplier is not None and not 0 < args.max_multiplier < 1:
         raise UsageError(f"--max-multiplier must be in (0, 1), got {args.max_multiplier:g}")
@@ -166,8 +166,10 @@ def add_parser(add: Any, model_arg: Any) -> None:
                         "(the closed loop's spectral radius under a fast output controller), then find the "
                         "closed loop's multipliers (a model with its own virtual constraints: its controller "
                         "is compiled once)")
-    o.add_argument("--steps", type=int, default=1,
-                   help="steps per period (default 1; 2: a two-step gait, each step with its own impact)")
+    o.add_argument("--steps", type=int, default=None,
+                   help="steps per period (default: one cycle of the walker's modes, 1 for a walker that relabels "
+                        "its legs, 2 for one whose stance feet are modes; 2: a two-step gait, each step with its "
+                        "own impact)")
     o.add_argument("--max-iter", type=int, default=500, dest="max_iter", help="solver iteration limit (default 500)")
     o.add_argument("--quiet", action="store_true", help="no solver progress on stderr")
     o.add_argument("--out", help="write the gait to FILE.json")

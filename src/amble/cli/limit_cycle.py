@@ -11,6 +11,7 @@ from typing import Any
 from ..analysis.defaults import FIXED_POINT_TOL, RESIDUAL_TOL
 from .animation import SERIES_HELP, drawing_outputs, write_animation
 from .args import UsageError, check_tol, load_model, parse_sets, parse_start, robot_options
+from .gait_file import gait_start
 from .output import gait_check_lines, write_output
 
 EXAMPLE = "amble limit-cycle compass-gait --set slope=0.0525 --plot cycle.png"
@@ -28,6 +29,8 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
                     help=f"fixed-point tolerance: the largest residual |P(x) - x| of the gait (default "
                          f"{RESIDUAL_TOL:g}, so that the fixed point is within 1e-10 of the map's)")
     lc.add_argument("--guess", help="'x0=V1,V2,...' initial guess (default: the model's)")
+    lc.add_argument("--gait", metavar="FILE.json", help="the limit cycle of a designed gait (amble optimize-gait "
+                    "--out): its fixed point as the guess, its parameters, its controller's included (--set overrides)")
     lc.add_argument("--plot", help="write the limit-cycle phase portrait FILE.png|.svg|.pdf")
     lc.add_argument("--animate", help="write an animation of the gait FILE.html|.gif|.mp4")
     lc.add_argument("--series", action="append", metavar="[TITLE=]NAME,...", help=SERIES_HELP)
@@ -46,8 +49,13 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError(f"--period must be at least 1 and at most {MAX_PERIOD}, got {args.period}")
     # the warm start: the compiled model without SymPy, unless drawing needs the symbolic one
     s = load_model(args.model, compiled=not (plot_p or anim_p), derivatives=True, **robot_options(args))
+    if args.gait is not None and args.guess is not None:
+        raise UsageError("give --guess or --gait, not both")
     params = parse_sets(args.set)
     guess = parse_start(s, args.guess, params, "--guess") if args.guess else None
+    if args.gait is not None:
+        guess, designed = gait_start(s, args.gait)
+        params = {**designed, **params}
     lc = find_fixed_point(s, guess, params=params, period=args.period, rtol=args.rtol, atol=args.atol,
                           tol=check_tol(args.tol))
     out = lc.to_json()

@@ -11,6 +11,7 @@ from ..models import LIMIT_ACTIONS
 from ..simulation.engine import METHODS, NEEDS_JACOBIAN, Options
 from .animation import SERIES_HELP, drawing_outputs, write_animation
 from .args import UsageError, load_model, parse_sets, parse_start, robot_options, writable_path
+from .gait_file import gait_start
 from .output import write_output
 
 EXAMPLE = "amble simulate compass-gait --steps 30 --set slope=0.06 --json --animate walk.html"
@@ -24,6 +25,8 @@ def add_parser(add: Callable[[str, str], argparse.ArgumentParser],
     g.add_argument("--steps", type=int, help="number of footfalls (default 20)")
     g.add_argument("--time", type=float, help="end time in seconds (default for a system without footfalls: 1)")
     s.add_argument("--start", help="'fixed-point' or 'x0=V1,V2,...' (full state, state_names order)")
+    s.add_argument("--gait", metavar="FILE.json", help="start on a designed gait (amble optimize-gait --out): its "
+                   "fixed point and parameters, its controller's included (--set overrides)")
     s.add_argument("--out", help="write samples to FILE.csv|.parquet|.npz")
     s.add_argument("--plot", help="write a time-series plot FILE.png|.svg|.pdf")
     s.add_argument("--animate", help="write an animation FILE.html (3D, offline)|.gif|.mp4")
@@ -55,8 +58,13 @@ def cmd_simulate(args: argparse.Namespace) -> dict[str, Any]:
                    **robot_options(args))
     if out_p and (any(m.inputs for m in s.modes.values()) or getattr(s, "hip", None) is not None):
         s = s.symbolic()  # the inputs and the ground reaction written per sample come from the symbolic model
+    if args.gait is not None and args.start is not None:
+        raise UsageError("give --start or --gait, not both")
     params = parse_sets(args.set)
     x0 = parse_start(s, args.start, params, "--start")
+    if args.gait is not None:
+        x0, designed = gait_start(s, args.gait)
+        params = {**designed, **params}
     t_end, steps = args.time, args.steps
     if steps is None and t_end is None:  # 20 footfalls; a system that makes none runs for a second
         walks = any(tr.step for tr in s.transitions)
