@@ -106,7 +106,7 @@ _READS = {
     "Actuators": {"input_unit", "input_matrix", "dynamics", "mass_and_bias"},
     "Model": {"dt", "diff", "jacobian", "point_jacobian", "point_velocity", "from_urdf", "constrained", "validate",
               "limit_guards"},
-    "HybridSystem": {"check_parameters", "unit", "frame_change", "state_names", "full", "symbolic"},
+    "HybridSystem": {"footfall_cycle", "check_parameters", "unit", "frame_change", "state_names", "full", "symbolic"},
     "Walker": {"slope_value", "frame_change"},
 }
 
