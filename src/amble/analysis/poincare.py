@@ -110,6 +110,8 @@ def find_fixed_point(
         if guess is not None or not params or at_defaults:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
         direct, direct_error = None, str(e).splitlines()[0] if str(e) else type(e).__name__
+    if direct is not None:
+        direct.found_by = "guess" if guess is not None else "walk"
     if direct is not None and (direct.stable or guess is not None or at_defaults):
         return direct
     try:
@@ -118,7 +120,9 @@ def find_fixed_point(
         if direct is not None:
             return direct
         # both searches say why they failed (e.g. the walk at these parameters ends at rest)
-        raise ConvergenceError(f"{e}; from a walk at these parameters: {direct_error}") from None
+        return _by_collocation(system, P, f"{e}; from a walk at these parameters: {direct_error}", tol=tol,
+                               max_iter=max_iter, jacobian=jacobian)
+    followed.found_by = "continuation"
     return followed if followed.stable or direct is None else direct
 
 
@@ -138,7 +142,9 @@ def continue_fixed_point(system: HybridSystem, x: Sequence[float], from_params: 
         xe = follow(Q, np.asarray(x, float), Q.p.copy(), P.p.copy(), tol=tol)
     except SimulationError as e:
         raise ConvergenceError(f"lost the branch: {e}") from None
-    return _newton(system, P, xe, period, tol, max_iter)
+    lc = _newton(system, P, xe, period, tol, max_iter)
+    lc.found_by = "continuation"
+    return lc
 
 
 def _scaled_start(system: HybridSystem, P: ReturnMap) -> np.ndarray | None:
@@ -189,6 +195,35 @@ def _from_defaults(system: HybridSystem, P: ReturnMap, **kw: Any) -> LimitCycle:
         except (ConvergenceError, SimulationError) as e:
             errors.append(str(e).splitlines()[0] if str(e) else type(e).__name__)
     raise ConvergenceError(f"no fixed point: following the default gait: {errors[0]}")
+
+
+def _by_collocation(system: HybridSystem, P: ReturnMap, tried: str, **kw: Any) -> LimitCycle:
+    """The last resort of :func:`find_fixed_point`: Newton from a periodic step solved by
+    collocation (:mod:`amble.analysis.collocation_guess`). ``tried`` says in one line why the
+    other searches failed; it is the result's ``search_note``, and the error's start when this
+    fails too. Tried after a fold of the model's branch as well: a gait found then lies on
+    another branch, which the note says."""
+    from .collocation_guess import collocation_starts
+
+    params = dict(zip(P.k.meta["params"], P.p.tolist()))
+    errors = []
+    try:
+        for start, x0, why in collocation_starts(system, params, P.period):
+            if x0 is None:
+                errors.append(f"from {start!r}: {why}")
+                continue
+            try:
+                _, x = initial_state(system, P.k, x0, P.mode)
+                lc = _newton(system, P, x, P.period, kw["tol"], kw["max_iter"], kw["jacobian"])
+            except (SimulationError, ConvergenceError, StateError) as e:
+                errors.append(f"from {start!r}: Newton from the collocated step: {str(e).splitlines()[0]}")
+                continue
+            lc.found_by = "collocation"
+            lc.search_note = tried
+            return lc
+    except ConvergenceError as e:
+        errors.append(str(e))
+    raise ConvergenceError(f"{tried}; by collocation: {'; '.join(errors)}")
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,
