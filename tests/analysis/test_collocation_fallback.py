@@ -74,3 +74,12 @@ def test_every_route_tried_is_named_in_one_line():
     assert "\n" not in msg
     assert "folds at slope = 0.04515" in msg and "from a walk at these parameters" in msg
     assert "by collocation: not applicable" in msg and "one domain" in msg
+
+
+def test_the_cli_says_a_gait_was_found_by_collocation_and_why(capsys):
+    from amble.cli.main import main
+
+    sets = [a for k, v in LOST.items() for a in ("--set", f"{k}={v}")]
+    assert main(["limit-cycle", "compass-gait", *sets]) == 0
+    out = capsys.readouterr().out
+    assert "found by collocation" in out and "lost the branch" in out and "UNSTABLE period-1 gait" in out
