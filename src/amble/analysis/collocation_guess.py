@@ -33,9 +33,10 @@ if TYPE_CHECKING:
 #: collocation intervals of the solve: a start for Newton, not the gait itself (30 intervals put
 #: the compass gait's post-impact state within ~1e-4 of the map's fixed point)
 NODES = 30
-#: IPOPT's tolerance: loose, since Newton on the return map polishes; a tight one makes IPOPT
-#: report a failure at points that hold every constraint to 1e-8 (the footfall's guard and the
-#: periodicity of the post-impact state on the section are dependent equations)
+#: IPOPT's tolerance: loose, since Newton on the return map polishes. A passive walker's problem
+#: without a pace has as many equations as unknowns (plus inequalities: contact, the footfall's
+#: enabling condition), where IPOPT often ends in a failed restoration at a point that already
+#: holds every constraint; a loose tolerance lets more of its solves end as solved
 TOL = 1e-6
 #: IPOPT iterations per solve
 MAX_ITER = 300
