@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ConvergenceError, ModelError, ParameterError, SolverError, StateError
+from .global_starts import register
 
 if TYPE_CHECKING:
     from ..modelling.hybrid import HybridSystem
@@ -81,6 +82,9 @@ def collocation_starts(system: HybridSystem, params: dict[str, float], period: i
 
 def _first_line(e: Any) -> str:
     return str(e).splitlines()[0] if str(e) else type(e).__name__
+
+
+register("collocation", collocation_starts)
 
 
 __all__ = ["MAX_ITER", "NODES", "STARTS", "TOL", "collocation_starts", "has_inputs"]

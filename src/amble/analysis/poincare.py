@@ -22,6 +22,7 @@ from ..errors import ConvergenceError, SimulationError, StateError
 from ..simulation.engine import run
 from ..simulation.simulate import initial_state, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .global_starts import GLOBAL_STARTS
 from .limit_cycle import LimitCycle
 from .mode_cycle import footfalls_per_cycle
 from .return_map import CHART_GROWTH, MAX_PERIOD, ReturnMap
@@ -198,32 +199,33 @@ def _from_defaults(system: HybridSystem, P: ReturnMap, **kw: Any) -> LimitCycle:
 
 
 def _by_collocation(system: HybridSystem, P: ReturnMap, tried: str, **kw: Any) -> LimitCycle:
-    """The last resort of :func:`find_fixed_point`: Newton from a periodic step solved by
-    collocation (:mod:`amble.analysis.collocation_guess`). ``tried`` says in one line why the
-    other searches failed; it is the result's ``search_note``, and the error's start when this
-    fails too. Tried after a fold of the model's branch as well: a gait found then lies on
-    another branch, which the note says."""
-    from .collocation_guess import collocation_starts
-
+    """The last resort of :func:`find_fixed_point`: Newton from each registered global start
+    (:mod:`amble.analysis.global_starts`: a periodic step solved by collocation,
+    :mod:`amble.analysis.collocation_guess`). ``tried`` says in one line why the other searches
+    failed; it is the result's ``search_note``, and the error's start when this fails too. Tried
+    after a fold of the model's branch as well: a gait found then lies on another branch, which
+    the note says."""
     params = dict(zip(P.k.meta["params"], P.p.tolist()))
-    errors = []
-    try:
-        for start, x0, why in collocation_starts(system, params, P.period):
-            if x0 is None:
-                errors.append(f"from {start!r}: {why}")
-                continue
-            try:
-                _, x = initial_state(system, P.k, x0, P.mode)
-                lc = _newton(system, P, x, P.period, kw["tol"], kw["max_iter"], kw["jacobian"])
-            except (SimulationError, ConvergenceError, StateError) as e:
-                errors.append(f"from {start!r}: Newton from the collocated step: {str(e).splitlines()[0]}")
-                continue
-            lc.found_by = "collocation"
-            lc.search_note = tried
-            return lc
-    except ConvergenceError as e:
-        errors.append(str(e))
-    raise ConvergenceError(f"{tried}; by collocation: {'; '.join(errors)}")
+    for method, starts in GLOBAL_STARTS:
+        errors = []
+        try:
+            for start, x0, why in starts(system, params, P.period):
+                if x0 is None:
+                    errors.append(f"from {start!r}: {why}")
+                    continue
+                try:
+                    _, x = initial_state(system, P.k, x0, P.mode)
+                    lc = _newton(system, P, x, P.period, kw["tol"], kw["max_iter"], kw["jacobian"])
+                except (SimulationError, ConvergenceError, StateError) as e:
+                    errors.append(f"from {start!r}: Newton from its state: {str(e).splitlines()[0]}")
+                    continue
+                lc.found_by = method
+                lc.search_note = tried
+                return lc
+        except ConvergenceError as e:
+            errors.append(str(e))
+        tried = f"{tried}; by {method}: {'; '.join(errors)}"
+    raise ConvergenceError(tried)
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,
