@@ -17,6 +17,9 @@ pytest.importorskip("casadi")
 # guess falls, and the continuation from the default gait loses its branch at 99 % of the way
 # (its corrector stalls at a residual of 3e-12, above the 1e-12 asked for)
 LOST = dict(mh=80.9022, m=0.1416, a=0.0689, b=0.4301, slope=0.0205)
+# light legs on a steep slope: the default gait's branch folds at slope 0.21751, just short of
+# 0.2182 (with the other parameters nearly there): no gait beyond on that branch
+FOLDS = dict(mh=0.9313, m=4.5418, a=0.1228, b=0.6294, slope=0.2182)
 # heavy legs, a light hip: the continuation does not reach the end in its 400 steps
 LONG = dict(mh=0.0478, m=26.6935, a=0.0859, b=0.721, slope=0.1063)
 
@@ -43,6 +46,14 @@ def test_collocation_finds_the_compass_gait_where_the_search_fails():
     assert "\n" not in lc.search_note
     _check_against_oracle(LOST, lc)
     assert lc.to_json()["found_by"] == "collocation"
+
+
+def test_after_a_fold_collocation_finds_a_gait_of_another_branch_and_says_so():
+    lc = find_fixed_point(load("compass-gait"), params=FOLDS)
+    assert lc.found_by == "collocation"
+    assert "the branch folds at" in lc.search_note and "no gait beyond on this branch" in lc.search_note
+    _check_against_oracle(FOLDS, lc)
+    assert not lc.stable  # a saddle far from the default gait (|μ| 47)
 
 
 @pytest.mark.slow
