@@ -93,9 +93,14 @@ def find_fixed_point(
     parameter derivatives, step control, branch jumps refused, a parameter that only rescales
     time, such as a passive walker's gravity, jumped exactly), and the cycle found that way is
     returned if it is stable: a walker whose default gait is stable finds the stable branch
-    connected to it, not whichever cycle lies nearest a poor guess. When nothing is found the
-    error says why in one line (the branch folds, the walker fell, the branch was lost) with the
-    last gait found on the way.
+    connected to it, not whichever cycle lies nearest a poor guess. When both fail (a fold of
+    that branch included: another branch may hold a gait), Newton starts from a periodic step
+    solved by collocation (:mod:`amble.analysis.collocation_guess`; a passive system only, with
+    CasADi). The result's ``found_by`` says which route found it (``"guess"``, ``"walk"``,
+    ``"continuation"``, ``"collocation"``) and, for collocation, ``search_note`` why the others
+    failed. When nothing is found the error says in one line what each route met (the branch
+    folds, the walker fell, the branch was lost, with the last gait found on the way; the
+    collocation's failure or why it does not apply).
     """
     if jacobian not in ("exact", "fd"):
         raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
