@@ -42,6 +42,14 @@ class LimitCycle:
     #: the period asked for, when the orbit found has a lower one (a period-k search converged to
     #: a period-d orbit repeated k/d times)
     requested_period: int | None = None
+    #: how the gait was found: ``"guess"`` (Newton from the guess given), ``"walk"`` (Newton from
+    #: a walk at these parameters), ``"continuation"`` (the model's gait followed from its default
+    #: parameters) or ``"collocation"`` (Newton from a periodic step solved by collocation, when
+    #: the others failed: :mod:`amble.analysis.collocation_guess`)
+    found_by: str = "guess"
+    #: for a gait found by collocation, in one line, why the other searches failed — where the
+    #: model's gait's branch folds, this gait lies on another branch
+    search_note: str = ""
 
     def trajectory(self, steps: int | None = None) -> Any:
         """Simulate the gait from the fixed point (default: two periods), samples every 5 ms."""
@@ -71,4 +79,6 @@ class LimitCycle:
             "orbit": self.orbit.tolist() if self.orbit is not None else [self.fixed_point.tolist()],
             "step_times": self.step_times or [self.step_time],
             "parameters": self.parameters,
+            "found_by": self.found_by,
+            "search_note": self.search_note,
         }

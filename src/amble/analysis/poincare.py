@@ -22,6 +22,7 @@ from ..errors import ConvergenceError, SimulationError, StateError
 from ..simulation.engine import run
 from ..simulation.simulate import initial_state, simulate
 from .defaults import FIXED_POINT_TOL, RESIDUAL_TOL
+from .global_starts import GLOBAL_STARTS
 from .limit_cycle import LimitCycle
 from .mode_cycle import footfalls_per_cycle
 from .return_map import CHART_GROWTH, MAX_PERIOD, ReturnMap
@@ -92,9 +93,14 @@ def find_fixed_point(
     parameter derivatives, step control, branch jumps refused, a parameter that only rescales
     time, such as a passive walker's gravity, jumped exactly), and the cycle found that way is
     returned if it is stable: a walker whose default gait is stable finds the stable branch
-    connected to it, not whichever cycle lies nearest a poor guess. When nothing is found the
-    error says why in one line (the branch folds, the walker fell, the branch was lost) with the
-    last gait found on the way.
+    connected to it, not whichever cycle lies nearest a poor guess. When both fail (a fold of
+    that branch included: another branch may hold a gait), Newton starts from a periodic step
+    solved by collocation (:mod:`amble.analysis.collocation_guess`; a passive system only, with
+    CasADi). The result's ``found_by`` says which route found it (``"guess"``, ``"walk"``,
+    ``"continuation"``, ``"collocation"``) and, for collocation, ``search_note`` why the others
+    failed. When nothing is found the error says in one line what each route met (the branch
+    folds, the walker fell, the branch was lost, with the last gait found on the way; the
+    collocation's failure or why it does not apply).
     """
     if jacobian not in ("exact", "fd"):
         raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
@@ -110,6 +116,8 @@ def find_fixed_point(
         if guess is not None or not params or at_defaults:
             raise ConvergenceError(f"no fixed point from this guess: {e}") from None
         direct, direct_error = None, str(e).splitlines()[0] if str(e) else type(e).__name__
+    if direct is not None:
+        direct.found_by = "guess" if guess is not None else "walk"
     if direct is not None and (direct.stable or guess is not None or at_defaults):
         return direct
     try:
@@ -118,7 +126,9 @@ def find_fixed_point(
         if direct is not None:
             return direct
         # both searches say why they failed (e.g. the walk at these parameters ends at rest)
-        raise ConvergenceError(f"{e}; from a walk at these parameters: {direct_error}") from None
+        return _by_collocation(system, P, f"{e}; from a walk at these parameters: {direct_error}", tol=tol,
+                               max_iter=max_iter, jacobian=jacobian)
+    followed.found_by = "continuation"
     return followed if followed.stable or direct is None else direct
 
 
@@ -138,7 +148,9 @@ def continue_fixed_point(system: HybridSystem, x: Sequence[float], from_params: 
         xe = follow(Q, np.asarray(x, float), Q.p.copy(), P.p.copy(), tol=tol)
     except SimulationError as e:
         raise ConvergenceError(f"lost the branch: {e}") from None
-    return _newton(system, P, xe, period, tol, max_iter)
+    lc = _newton(system, P, xe, period, tol, max_iter)
+    lc.found_by = "continuation"
+    return lc
 
 
 def _scaled_start(system: HybridSystem, P: ReturnMap) -> np.ndarray | None:
@@ -189,6 +201,36 @@ def _from_defaults(system: HybridSystem, P: ReturnMap, **kw: Any) -> LimitCycle:
         except (ConvergenceError, SimulationError) as e:
             errors.append(str(e).splitlines()[0] if str(e) else type(e).__name__)
     raise ConvergenceError(f"no fixed point: following the default gait: {errors[0]}")
+
+
+def _by_collocation(system: HybridSystem, P: ReturnMap, tried: str, **kw: Any) -> LimitCycle:
+    """The last resort of :func:`find_fixed_point`: Newton from each registered global start
+    (:mod:`amble.analysis.global_starts`: a periodic step solved by collocation,
+    :mod:`amble.analysis.collocation_guess`). ``tried`` says in one line why the other searches
+    failed; it is the result's ``search_note``, and the error's start when this fails too. Tried
+    after a fold of the model's branch as well: a gait found then lies on another branch, which
+    the note says."""
+    params = dict(zip(P.k.meta["params"], P.p.tolist()))
+    for method, starts in GLOBAL_STARTS:
+        errors = []
+        try:
+            for start, x0, why in starts(system, params, P.period):
+                if x0 is None:
+                    errors.append(f"from {start!r}: {why}")
+                    continue
+                try:
+                    _, x = initial_state(system, P.k, x0, P.mode)
+                    lc = _newton(system, P, x, P.period, kw["tol"], kw["max_iter"], kw["jacobian"])
+                except (SimulationError, ConvergenceError, StateError) as e:
+                    errors.append(f"from {start!r}: Newton from its state: {str(e).splitlines()[0]}")
+                    continue
+                lc.found_by = method
+                lc.search_note = tried
+                return lc
+        except ConvergenceError as e:
+            errors.append(str(e))
+        tried = f"{tried}; by {method}: {'; '.join(errors)}"
+    raise ConvergenceError(tried)
 
 
 def _newton(system: HybridSystem, P: ReturnMap, x: np.ndarray, period: int, tol: float, max_iter: int,

@@ -89,6 +89,11 @@ def cmd_limit_cycle(args: argparse.Namespace) -> dict[str, Any]:
         print(f"{args.model}: {'stable' if lc.stable else 'UNSTABLE'} period-{lc.period} gait, "
               f"{'mean ' if lc.period > 1 else ''}step time {lc.step_time:.6g} {unit} "
               f"(residual {lc.residual:.1e}, {lc.iterations} iterations)")
+        if lc.found_by == "continuation":
+            print("found by following the model's gait from its default parameters")
+        elif lc.found_by == "collocation":  # not connected to the model's gait: say why the other searches failed
+            print(f"found by collocation (Newton from a periodic step solved by the gait optimiser), as the other "
+                  f"searches failed: {lc.search_note}")
         if lc.period == 1:
             print("fixed point: " + ", ".join(f"{n}={v:.9g}" for n, v in zip(lc.state_names, lc.fixed_point)))
         else:  # every point of the orbit and the time of every step: the mean alone hides the alternation
