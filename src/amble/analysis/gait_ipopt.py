@@ -27,10 +27,17 @@ _FAILURES = {
 
 def _solve_nlp(ca: Any, nlp: dict[str, Any], opts: dict[str, Any], progress: bool, tol: float,
                groups: list[tuple[str, Any, float, float]], bound_groups: list[tuple[str, int, int]],
-               **problem: Any) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any], float]:
+               feasibility: bool = False, **problem: Any
+               ) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any], float]:
     """IPOPT on ``nlp`` from ``problem`` (start and bounds): the solution, IPOPT's statistics, the
     constraint report and the seconds it took; a failure is a :class:`SolverError` naming the reason
-    and the most violated constraint, Ctrl-C a ``KeyboardInterrupt``."""
+    and the most violated constraint, Ctrl-C a ``KeyboardInterrupt``.
+
+    ``feasibility``: the problem has nothing to optimise (a passive walker: no inputs, or a zero
+    objective), so a last iterate that satisfies every constraint within ``tol`` is the answer
+    whatever IPOPT's status. A passive walker's step has as many equations as unknowns, and IPOPT
+    often ends such a problem in a failed restoration phase at a point where every constraint
+    holds (7 of 9 compass gaits far from the defaults)."""
     solver = ca.nlpsol("gait", "ipopt", nlp, opts)
     t0 = time.perf_counter()
     with StdoutToStderr(progress), Interrupts() as interrupted:
@@ -43,7 +50,10 @@ def _solve_nlp(ca: Any, nlp: dict[str, Any], opts: dict[str, Any], progress: boo
     report = constraint_report(groups, gval, problem["lbg"], problem["ubg"], np.asarray(sol["x"]).ravel(),
                                problem["lbx"], problem["ubx"], bound_groups)
     status = stats.get("return_status", "unknown")
-    if not stats.get("success", False) and status != "Solved_To_Acceptable_Level":
+    feasible = feasibility and all(r["max_violation"] <= tol for r in report.values())
+    if feasible and not stats.get("success", False):
+        stats["return_status"] = f"Feasible_Point_Found ({status})"
+    if not stats.get("success", False) and status != "Solved_To_Acceptable_Level" and not feasible:
         worst = max(report.items(), key=lambda kv: kv[1]["max_violation"])
         reason = _FAILURES.get(status, status.replace("_", " ").lower())
         binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"

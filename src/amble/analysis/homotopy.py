@@ -55,6 +55,12 @@ JUMP_MULTIPLIER = 0.25
 MAX_DS = 0.125
 MIN_STEP = 1e-6
 CORRECTOR_ITER = 8
+#: Residual to which the points along a path are corrected, at least (the caller's ``tol`` if
+#: larger): they are predictions' bases, not results — the end is polished by the caller's Newton.
+#: Far from the defaults the return map holds only about 1e-12 (a compass gait at mh = 2.5,
+#: m = 0.48, a = 0.08, slope 0.18: Newton stalls at 1.8e-12), and a path corrected to 1e-12 there was
+#: "lost" with its gait in hand.
+CORRECTOR_TOL = 1e-10
 #: Steps along one path, at most.
 MAX_STEPS = 400
 #: Relative residual below which a scaled gait counts as a gait (the symmetry holds).
@@ -180,13 +186,15 @@ def _spread(a: np.ndarray, b: np.ndarray) -> float:
 def follow(P: ReturnMap, x: np.ndarray, p0: np.ndarray, p1: np.ndarray, *, tol: float,
            geometric: bool = False) -> np.ndarray:
     """Carry the gait ``x`` of ``P`` at ``p0`` to ``p1``; returns the gait at ``p1`` (full state,
-    a zero of ``F`` to ``tol``). ``P.p`` is left at ``p1``.
+    a zero of ``F`` to ``tol``, or :data:`CORRECTOR_TOL` if larger: polish it with Newton). ``P.p``
+    is left at ``p1``.
 
     Raises :class:`ConvergenceError` with one line saying what happened and the last good gait:
     the branch folds (``s`` turns back: no gait beyond on this branch), the walker fell, or the
     branch was lost (no step down to :data:`MIN_STEP` was accepted).
     """
     names = list(P.k.meta["params"])
+    tol = max(tol, CORRECTOR_TOL)
     path = _Path(P, np.asarray(p0, float), np.asarray(p1, float), geometric)
     u = np.r_[np.asarray(x, float), 0.0]
     r, J, T, dT = path.F(u)
