@@ -160,15 +160,17 @@ def _boundary(i: int, j: int, i2: int, j2: int, ae: np.ndarray, be: np.ndarray) 
     return [(be[j], y), (be[j + 1], y)]
 
 
-def _draw_curves(ax: Any, result: Any, ae: np.ndarray, be: np.ndarray, system: Any, params: Any) -> None:
+def _draw_curves(ax: Any, result: Any, ae: np.ndarray, be: np.ndarray, system: Any, params: Any,
+                 found: list | None) -> None:
     """The map's bifurcation curves (fold, flip, torus crossings between cells of one branch) and
     the boundaries where a row's branch changed, as segments on the cell boundaries."""
     from matplotlib.collections import LineCollection
 
     from ..analysis.map_bifurcations import branch_boundaries, map_crossings
 
-    has_mu = any(r.get("multipliers") for r in result.rows if r.get("status") == "ok")
-    found = map_crossings(result, system, params=params) if has_mu and hasattr(result, "kind") else []
+    if found is None:
+        has_mu = any(r.get("multipliers") for r in result.rows if r.get("status") == "ok")
+        found = map_crossings(result, system, params=params) if has_mu and hasattr(result, "kind") else []
     for kind, (col, ls, label) in _CURVES.items():
         segs = [_boundary(c.i, c.j, c.i2, c.j2, ae, be) for c in found if c.kind == kind]
         if segs:
@@ -181,15 +183,16 @@ def _draw_curves(ax: Any, result: Any, ae: np.ndarray, be: np.ndarray, system: A
 
 
 def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | None = None, system: Any = None,
-                       params: Any = None) -> Path:
+                       params: Any = None, crossings: list | None = None) -> Path:
     """Two-parameter map of the largest multiplier modulus (colour, log scale) over cells centred
     on the grid values, the |λ| = 1 contour, grey cells where no fixed point was found, and the
     map's bifurcation curves on the cell boundaries: fold (orange), flip (red, dashed) and torus
     (magenta, dotted) crossings between neighbouring cells of one branch
     (:func:`amble.analysis.map_bifurcations.map_crossings`; ``system`` and ``params``, the
-    sweep's other parameters, decide exactly whether cells of different rows are one branch).
-    Where a row's branch changed, the boundary is dash-dotted and the cells off the row's main
-    branch are marked ×: a |λ| = 1 contour there is a change of gait, not a bifurcation."""
+    sweep's other parameters, decide exactly whether cells of different rows are one branch;
+    ``crossings``: that function's answer, when already at hand). Where a row's branch changed,
+    the boundary is dash-dotted and the cells off the row's main branch are marked ×: a |λ| = 1
+    contour there is a change of gait, not a bifurcation."""
     plt = _plt()
     from matplotlib.colors import LogNorm
 
@@ -213,7 +216,7 @@ def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | Non
     if ni > 1 and nj > 1 and finite:
         ax.contour(bv, av, M, levels=[1.0], colors="w", linewidths=1.5)
     fig.colorbar(im, ax=ax, label="largest multiplier modulus |λ| (1)")
-    _draw_curves(ax, result, ae, be, system, params)
+    _draw_curves(ax, result, ae, be, system, params, crossings)
     branched = _mark_branches(ax, result.rows, a, b)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="upper right", framealpha=0.85)
