@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from test_torus import _oscillator
 
+import amble
 from amble import sweep
 from amble.analysis.branch_bifurcations import multiplier_tests
 from amble.analysis.map_bifurcations import branch_boundaries, crossed_kinds, map_crossings
@@ -187,3 +188,4 @@ def test_cli_reports_the_map_curves(capsys):
     rc = main(["sweep", "compass-gait", "--param", "mh=9:11:3", "--param", "slope=0.0733:0.0803:5",
                "--scheduler", "synchronous"])
     assert rc == 0 and "bifurcation curves: flip between" in capsys.readouterr().out
+    assert amble.map_crossings is map_crossings
