@@ -46,6 +46,7 @@ _WHERE: dict[str, str] = {
     "sweep": ".analysis.sweep",
     "period_doubling": ".analysis.doubling",
     "bifurcations": ".analysis.branch_bifurcations",
+    "map_crossings": ".analysis.map_bifurcations",
     **dict.fromkeys(("sweep_fixed_points", "sweep_fixed_points_2d"), ".analysis.fixed_points"),
     **dict.fromkeys(("bifurcation", "poincare_iterates"), ".analysis.bifurcation"),
     **dict.fromkeys(("cascade", "continue_branch", "switch_at_flip"), ".analysis.continuation"),
@@ -69,6 +70,7 @@ _WHERE: dict[str, str] = {
     **dict.fromkeys(("Event", "Trajectory"), ".simulation.trajectory"),
     **dict.fromkeys(("animate", "plot_limit_cycle", "plot_trajectory"), ".viz"),
     **dict.fromkeys(("plot_metastable", "plot_mfpt_against"), ".viz.metastable"),
+    "plot_parameter_map": ".viz.sweep_plots",
 }
 
 __all__ = sorted(_WHERE, key=lambda n: (not n.isupper(), n))

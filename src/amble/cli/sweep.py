@@ -3,7 +3,8 @@
 Turns the parsed options into one call of :func:`~amble.analysis.sweep.sweep` with the kind of
 ``--kind``, reads where the gait period-doubles with :func:`~amble.analysis.doubling.period_doubling`
 and every fold, flip and torus point a branch crosses with
-:func:`~amble.analysis.branch_bifurcations.bifurcations`, prints a short report (or returns it for
+:func:`~amble.analysis.branch_bifurcations.bifurcations` (a map's curves with
+:func:`~amble.analysis.map_bifurcations.map_crossings`), prints a short report (or returns it for
 ``--json``) and draws the plot. Bad input raises :class:`amble.cli.UsageError` (exit code 2) before any work starts.
 """
 
@@ -12,6 +13,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections import Counter
 from typing import Any
 
 import numpy as np
@@ -21,6 +23,7 @@ from ..analysis.branch_bifurcations import bifurcations
 from ..analysis.continuation_sweep import bifurcation_rows
 from ..analysis.defaults import BASIN_STEPS
 from ..analysis.doubling import period_doubling
+from ..analysis.map_bifurcations import MapCrossing, map_crossings
 from ..analysis.sweep import sweep
 from ..simulation.engine import Options
 from .args import (
@@ -96,7 +99,8 @@ def sweep_cli(args: Any) -> dict[str, Any]:
         draw = (sp.plot_basin if basin_kind else sp.plot_bifurcation if args.kind == "bifurcation"
                 else sp.plot_continuation if args.kind == "continuation"
                 else sp.plot_branch if len(names) == 1 else sp.plot_parameter_map)
-        write_output(plot, lambda part: draw(res, part), "--plot")
+        kw = {"crossings": [MapCrossing(**c) for c in summary["crossings"]]} if "crossings" in summary else {}
+        write_output(plot, lambda part: draw(res, part, **kw), "--plot")
         summary["plot"] = str(plot)
     if not getattr(args, "json", False):
         _print(summary, out, plot)
@@ -185,6 +189,9 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
         summary["stable_range"] = [float(st[0][names[0]]), float(st[-1][names[0]])] if st else None
     else:
         summary["stable"] = sum(1 for r in res.rows if r["stable"] == "true")
+        # the map's bifurcation curves: sign changes between neighbouring cells of one branch
+        found = map_crossings(res, system, params=common["params"], **{k: common[k] for k in ("tol",) if k in common})
+        summary["crossings"] = [c._asdict() for c in found]
     summary.update(res.counts())
     return _point_summary(res, names, summary)
 
@@ -240,6 +247,10 @@ def _print(summary: dict[str, Any], out: Any, plot: Any) -> None:
               f"{b['points']} points ({b['stable_points']} stable); {b['end']}")
     for b in summary.get("bifurcations", []):
         print(_bifurcation_line(b, p))
+    if "crossings" in summary:
+        tally = Counter(c["kind"] for c in summary["crossings"])
+        print("  bifurcation curves: " + (", ".join(f"{k} between {n} pairs of cells" for k, n in sorted(tally.items()))
+                                          or "none crossed between cells of one branch"))
     if out is not None:
         print(f"  results: {out}")
     if plot is not None:

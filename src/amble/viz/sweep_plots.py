@@ -134,9 +134,65 @@ def plot_branch(result: Any, path: str | os.PathLike, *, coordinate: str | None 
     return _save(fig, path)
 
 
-def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
-    """Two-parameter map of the largest multiplier modulus (colour, log scale), the |λ| = 1
-    contour, and grey cells where no fixed point was found."""
+def _edges(v: np.ndarray) -> np.ndarray:
+    """Cell edges of grid values ``v`` (in their order): midway between neighbours, the outer
+    ones half a spacing beyond the ends (half a unit, or half the value, for a single value)."""
+    if v.size == 1:
+        h = 0.5 * (abs(v[0]) or 1.0)
+        return np.array([v[0] - h, v[0] + h])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.r_[2 * v[0] - mid[0], mid, 2 * v[-1] - mid[-1]]
+
+
+#: how each bifurcation curve of a map is drawn on the cell boundaries: colour, line style, label
+_CURVES = {"fold": ("tab:orange", "-", "fold (μ = +1)"),
+           "flip": ("tab:red", "--", "flip (period doubling, μ = −1)"),
+           "torus": ("magenta", ":", "torus (Neimark–Sacker, complex |μ| = 1)")}
+
+
+def _boundary(i: int, j: int, i2: int, j2: int, ae: np.ndarray, be: np.ndarray) -> list[tuple[float, float]]:
+    """The segment (in plot coordinates: x the second parameter, y the first) of the boundary
+    between neighbouring cells (i, j) and (i2, j2)."""
+    if i2 == i:  # neighbours along the second parameter: a vertical edge
+        x = be[j + 1]
+        return [(x, ae[i]), (x, ae[i + 1])]
+    y = ae[i + 1]
+    return [(be[j], y), (be[j + 1], y)]
+
+
+def _draw_curves(ax: Any, result: Any, ae: np.ndarray, be: np.ndarray, system: Any, params: Any,
+                 found: list | None) -> None:
+    """The map's bifurcation curves (fold, flip, torus crossings between cells of one branch) and
+    the boundaries where a row's branch changed, as segments on the cell boundaries."""
+    from matplotlib.collections import LineCollection
+
+    from ..analysis.map_bifurcations import branch_boundaries, map_crossings
+
+    if found is None:
+        has_mu = any(r.get("multipliers") for r in result.rows if r.get("status") == "ok")
+        found = map_crossings(result, system, params=params) if has_mu and hasattr(result, "kind") else []
+    for kind, (col, ls, label) in _CURVES.items():
+        segs = [_boundary(c.i, c.j, c.i2, c.j2, ae, be) for c in found if c.kind == kind]
+        if segs:
+            ax.add_collection(LineCollection(segs, colors=col, linestyles=ls, linewidths=2.6, label=label,
+                                             gid=f"crossing_{kind}", capstyle="round"))
+    segs = [_boundary(*p, ae, be) for p in branch_boundaries(result)]
+    if segs:
+        ax.add_collection(LineCollection(segs, colors="k", linestyles="-.", linewidths=1.2,
+                                         label="branch changed (no bifurcation)", gid="branch_boundary"))
+
+
+def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | None = None, system: Any = None,
+                       params: Any = None, crossings: list | None = None) -> Path:
+    """Two-parameter map of the largest multiplier modulus (colour, log scale) over cells centred
+    on the grid values, the |λ| = 1 contour, grey cells where no fixed point was found, and the
+    map's bifurcation curves on the cell boundaries: fold (orange), flip (red, dashed) and torus
+    (magenta, dotted) crossings between neighbouring cells of one branch
+    (:func:`amble.analysis.map_bifurcations.map_crossings`; ``system`` and ``params``, the
+    sweep's other parameters, decide exactly whether cells of different rows are one branch;
+    ``crossings``: that function's answer, when already at hand). Where a row's branch changed,
+    the boundary is dash-dotted and the cells off the row's main branch are marked ×: a |λ| = 1
+    contour there is a change of gait, not a bifurcation."""
     plt = _plt()
     from matplotlib.colors import LogNorm
 
@@ -150,20 +206,26 @@ def plot_parameter_map(result: Any, path: str | os.PathLike, *, title: str | Non
         av[i], bv[j] = float(r[a]), float(r[b])
         if r["status"] == "ok":
             M[i, j] = float(r["max_modulus"])
+    ae, be = _edges(av), _edges(bv)
     fig, ax = plt.subplots(figsize=(6.5, 5))
     ax.set_facecolor("0.85")
-    ext = [bv.min(), bv.max(), av.min(), av.max()]
-    im = ax.imshow(M, origin="lower", aspect="auto", extent=ext, cmap="viridis",
-                   norm=LogNorm(vmin=np.nanmin(M) if np.isfinite(M).any() else 0.1,
-                                vmax=max(np.nanmax(M), 1.01) if np.isfinite(M).any() else 10))
-    if ni > 1 and nj > 1 and np.isfinite(M).any():
+    finite = np.isfinite(M).any()
+    im = ax.pcolormesh(be, ae, np.ma.masked_invalid(M), cmap="viridis", shading="flat",
+                       norm=LogNorm(vmin=np.nanmin(M) if finite else 0.1,
+                                    vmax=max(np.nanmax(M), 1.01) if finite else 10))
+    if ni > 1 and nj > 1 and finite:
         ax.contour(bv, av, M, levels=[1.0], colors="w", linewidths=1.5)
     fig.colorbar(im, ax=ax, label="largest multiplier modulus |λ| (1)")
+    _draw_curves(ax, result, ae, be, system, params, crossings)
     branched = _mark_branches(ax, result.rows, a, b)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="upper right", framealpha=0.85)
+    ax.set_xlim(be.min(), be.max())
+    ax.set_ylim(ae.min(), ae.max())
     ax.set_xlabel(_label(b))
     ax.set_ylabel(_label(a))
     ax.set_title(title or "Stability map (white: |λ| = 1; grey: no fixed point"
-                 + ("; marked: another branch)" if branched else ")"))
+                 + ("; ×: another branch)" if branched else ")"), fontsize=10)
     return _save(fig, path)
 
 
@@ -203,9 +265,7 @@ def _mark_branches(ax: Any, rows: Any, a: str, b: str) -> bool:
     for n, (k, pts) in enumerate(sorted(marked.items())):
         xy = np.array(pts)
         ax.scatter(xy[:, 0], xy[:, 1], marker="x", s=28, color=f"C{(n + 1) % 10}", linewidths=1.2,
-                   label=f"branch {k}", gid="branch_change")
-    if marked:
-        ax.legend(fontsize=7, loc="upper right", title="another branch than most of its row", title_fontsize=7)
+                   label=f"branch {k} (not its row's main one)", gid="branch_change")
     return bool(marked)
 
 
