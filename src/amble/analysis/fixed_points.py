@@ -66,7 +66,7 @@ def _fp_task(system: HybridSystem, base: dict[str, float], pnames: list[str], po
                 broke = _first_line(e)
         if lc is None:
             try:
-                lc = find_fixed_point(system, None, params=params, **kw)
+                lc = find_fixed_point(system, None, params=params, collocation=False, **kw)
                 branch = flat[n] if flat is not None else i
             except AmbleError as e:
                 reason = broke or _first_line(e)

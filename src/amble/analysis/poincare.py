@@ -72,6 +72,7 @@ def find_fixed_point(
     tol: float = RESIDUAL_TOL,
     max_iter: int = 40,
     jacobian: str = "exact",
+    collocation: bool = True,
 ) -> LimitCycle:
     """Fixed point of the ``period``-step return map, its step time and Floquet multipliers.
 
@@ -100,7 +101,9 @@ def find_fixed_point(
     ``"continuation"``, ``"collocation"``) and, for collocation, ``search_note`` why the others
     failed. When nothing is found the error says in one line what each route met (the branch
     folds, the walker fell, the branch was lost, with the last gait found on the way; the
-    collocation's failure or why it does not apply).
+    collocation's failure or why it does not apply). ``collocation=False`` leaves that last
+    resort out (a sweep does: its points are continued along their branch, and a failed point is
+    reported as such rather than searched for at length).
     """
     if jacobian not in ("exact", "fd"):
         raise StateError(f"jacobian must be 'exact' or 'fd', got {jacobian!r}")
@@ -125,6 +128,8 @@ def find_fixed_point(
     except ConvergenceError as e:
         if direct is not None:
             return direct
+        if not collocation:
+            raise ConvergenceError(f"{e}; from a walk at these parameters: {direct_error}") from None
         # both searches say why they failed (e.g. the walk at these parameters ends at rest)
         return _by_collocation(system, P, f"{e}; from a walk at these parameters: {direct_error}", tol=tol,
                                max_iter=max_iter, jacobian=jacobian)
