@@ -46,15 +46,17 @@ def rabbit_two_modes() -> Walker:
                               hip="torso", max_step_time=2.0)
 
 
-def compass_two_modes_hzd(slope: float = 0.05, degree: int = 4) -> Walker:
+def compass_two_modes_hzd(slope: float = 0.05, degree: int = 4, shared: bool = True) -> Walker:
     """The two-mode compass gait with a hip motor (``u_hip`` on ``swing − stance``, 40 N·m) under
     hybrid zero dynamics in both modes: the output ``stance + swing`` (zero when the legs stand
     symmetric about the vertical) follows a Bézier polynomial in the phase ``stance``; the
-    coefficients ``alpha_0_k`` are parameters shared by the two modes, held at zero (legs
-    symmetric) until a designed gait's are given."""
+    coefficients ``alpha_0_k`` are parameters shared by the two modes (``shared=False``: each
+    mode its own, ``<mode>_alpha_0_k``), held at zero (legs symmetric) until a designed gait's are
+    given."""
     w = compass_two_modes(slope)
     for m in w.modes.values():
         st, sw = m.q
         m.actuator("u_hip", on=sw - st, limit=40.0)
-        m.virtual_constraints([st + sw], st, [[0.0] * (degree + 1)], (-0.2, 0.2), epsilon=0.05)
+        m.virtual_constraints([st + sw], st, [[0.0] * (degree + 1)], (-0.2, 0.2), epsilon=0.05,
+                              prefix="" if shared else f"{m.name.split('-')[-1]}_")
     return w

@@ -94,3 +94,21 @@ def test_a_two_mode_hzd_gait_walks_in_closed_loop_with_the_restricted_maps_multi
     assert loop["residual"] <= 1e-10 and loop["fixed_point_distance"] <= 2e-4  # the collocation's error
     assert loop["spectral_radius"] == pytest.approx(mu, rel=1e-8)
     assert abs(complex(*loop["multipliers"][1])) <= 1e-9  # transverse to the zero dynamics: ε small
+
+
+def test_each_stance_mode_may_keep_its_own_controller():
+    """Coefficients named per mode are unknowns per step: a relaxation of one shared set, so its
+    optimum is at most the shared design's (at a speed only the pair's pace is held: the pair's
+    optimum is asymmetric, each step with its own polynomial), and the compiled controller walks it."""
+    shared = optimize_gait(compass_two_modes_hzd(), nodes=20, speed=0.6, guess="interpolate", step_time=0.7)
+    w = compass_two_modes_hzd(shared=False)
+    own = optimize_gait(w, nodes=20, speed=0.6, guess="interpolate", step_time=0.7)
+    p = own.bezier["params"]
+    assert {"left_alpha_0_0", "right_alpha_0_0", "left_phase_start", "right_phase_end"} <= set(p)
+    assert own.objective <= shared.objective * (1 + 1e-9)
+    assert abs(p["left_alpha_0_2"] - p["right_alpha_0_2"]) > 1e-3  # two polynomials, not one
+    assert own.steps[0].bezier["alpha"] != own.steps[1].bezier["alpha"]
+    walk = simulate(w, x0=own.fixed_point, params={**own.params, **p}, steps=20, t_end=60.0)
+    assert walk.status == "completed" and len(walk.step_events) == 20
+    loop = closed_loop_stability(w, own)
+    assert loop["spectral_radius"] == pytest.approx(own.stability["restricted_multiplier"], rel=1e-8)

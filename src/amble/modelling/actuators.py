@@ -137,17 +137,18 @@ class Actuators(Names):
 
     @declaration
     def virtual_constraints(self, outputs: Any, phase: Any, alpha: Any, phase_range: tuple[float, float],
-                            epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0) -> Any:
+                            epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0, prefix: str = "") -> Any:
         """Control the inputs by hybrid zero dynamics: drive ``y = outputs(q) − h_d(phase(q), α)``
         to zero with ``ÿ = −kd ẏ/ε − kp y/ε²`` (see :mod:`amble.modelling.virtual`). ``alpha``
         holds one row of Bézier coefficients (rad) per output, ``phase_range`` the phase
         variable's values ``(θ⁺, θ⁻)`` just after and at a footfall. All become parameters
-        (``alpha_<i>_<k>``, ``phase_start``, ``phase_end``, ``epsilon``, ``kp``, ``kd``).
-        Returns the :class:`~amble.modelling.virtual.VirtualConstraints`."""
+        (``alpha_<i>_<k>``, ``phase_start``, ``phase_end``, ``epsilon``, ``kp``, ``kd``; the
+        first three names begin with ``prefix`` if given: modes of one system that each keep their
+        own coefficients). Returns the :class:`~amble.modelling.virtual.VirtualConstraints`."""
         from .domain import POSITIVE
         from .virtual import declare
 
-        vc = declare(self, outputs, phase, alpha, phase_range, epsilon, kp, kd)
+        vc = declare(self, outputs, phase, alpha, phase_range, epsilon, kp, kd, prefix)
         self.declare_domains(epsilon=POSITIVE)
         return vc
 

@@ -72,7 +72,11 @@ class VirtualOutputs:
     module docstring); ``phase_range``: its values ``(θ⁺, θ⁻)`` just after and at a footfall
     (m for ``"hip"``). ``epsilon`` (s), ``kp``, ``kd``: the output dynamics
     ``ÿ = −kd ẏ/ε − kp y/ε²``. ``mirror``: the second mode's outputs are mirror images of the
-    first's (module docstring); ``False``: the same joints, unsigned."""
+    first's (module docstring); ``False``: the same joints, unsigned. ``shared``: one set of
+    coefficients and phase range for both modes (a gait whose steps are mirror images); ``False``:
+    each mode its own, ``<mode>_alpha_<i>_<k>``, ``<mode>_phase_start``, ``<mode>_phase_end`` — a
+    robot whose legs are mirror images only to some digits (Bolt's centres of mass differ by
+    1e-5 m from leg to leg) has no gait whose steps are exact mirror images."""
 
     degree: int = 4
     alpha: Sequence[Sequence[float]] | None = None
@@ -82,6 +86,7 @@ class VirtualOutputs:
     kp: float = 1.0
     kd: float = 2.0
     mirror: bool = True
+    shared: bool = True
 
 
 @dataclass
@@ -268,7 +273,7 @@ def _declare_outputs(modes: Mapping[str, Model], legs: dict[str, list[str]], sig
             raise ModelError(f"virtual constraints: phase must be 'hip' or a callable model -> expression, "
                              f"got {spec.phase!r}")
         m.virtual_constraints(outputs, phase, rows, spec.phase_range, epsilon=spec.epsilon, kp=spec.kp,
-                              kd=spec.kd)
+                              kd=spec.kd, prefix="" if spec.shared else f"{mode}_")
 
 
 def point_foot_walker(path: str | Path, feet: Mapping[str, tuple[str, Sequence[float]]], hip: str | None = None,

@@ -65,7 +65,7 @@ class VirtualConstraints:
 
 
 def declare(model: Any, outputs: Sequence[Any], phase: Any, alpha: Any, phase_range: tuple[float, float],
-            epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0) -> VirtualConstraints:
+            epsilon: float = 0.1, kp: float = 1.0, kd: float = 2.0, prefix: str = "") -> VirtualConstraints:
     """Declare the virtual constraints on ``model`` (see :meth:`Model.virtual_constraints`)."""
     outs = [checked_expr(model, o, "virtual-constraint output") for o in outputs]
     ph = checked_expr(model, phase, "phase variable")
@@ -83,15 +83,15 @@ def declare(model: Any, outputs: Sequence[Any], phase: Any, alpha: Any, phase_ra
                          "(one Bézier polynomial per output)")
     if model._laws:
         raise ModelError(f"model {model.name!r}: virtual constraints set the control law; it has one already")
-    syms = [[model.parameter(f"alpha_{i}_{k}", v, f"Bézier coefficient {k} of output {i}", "rad")
+    syms = [[model.parameter(f"{prefix}alpha_{i}_{k}", v, f"Bézier coefficient {k} of output {i}", "rad")
              for k, v in enumerate(r)] for i, r in enumerate(rows)]
     th0, th1 = phase_range
     if not float(th0) != float(th1):
         raise ModelError(f"model {model.name!r}: the phase range must have two different ends")
     vc = VirtualConstraints(
         sp.Matrix(outs), ph, sp.Matrix(syms),
-        model.parameter("phase_start", th0, "phase variable just after the footfall θ⁺"),
-        model.parameter("phase_end", th1, "phase variable at the footfall θ⁻"),
+        model.parameter(f"{prefix}phase_start", th0, "phase variable just after the footfall θ⁺"),
+        model.parameter(f"{prefix}phase_end", th1, "phase variable at the footfall θ⁻"),
         model.parameter("epsilon", epsilon, "time scale of the output dynamics ε", "s"),
         model.parameter("kp", kp, "proportional gain of the output dynamics"),
         model.parameter("kd", kd, "derivative gain of the output dynamics"))
