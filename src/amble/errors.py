@@ -46,7 +46,11 @@ class SchedulerError(AmbleError, ConnectionError):
 
 class SolverError(AmbleError, RuntimeError):
     """A numerical optimisation did not succeed (infeasible, restoration failed, iteration limit);
-    the message names the reason and the most violated constraint."""
+    the message names the reason and the most violated constraint. ``gait``: for a gait
+    optimisation whose last iterate satisfies every constraint (a periodic gait, not certified
+    optimal), that gait; else None."""
+
+    gait: object = None
 
 
 class ExpressionError(ModelError, ParameterError):

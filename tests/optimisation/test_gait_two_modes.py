@@ -112,3 +112,27 @@ def test_each_stance_mode_may_keep_its_own_controller():
     assert walk.status == "completed" and len(walk.step_events) == 20
     loop = closed_loop_stability(w, own)
     assert loop["spectral_radius"] == pytest.approx(own.stability["restricted_multiplier"], rel=1e-8)
+
+
+def test_a_solver_stopped_at_a_feasible_point_hands_back_its_gait(monkeypatch):
+    """IPOPT stopped where every constraint holds but optimality is not certified (the iteration
+    limit on a 3D biped): the error carries the periodic gait of its last iterate, read back like
+    a solution. The stop is made here by letting the solver finish and reporting it as stopped."""
+    import amble.analysis.gait_optimisation as go
+    from amble.errors import SolverError
+
+    real = go._solve_nlp
+
+    def stopped(*args, **kw):
+        out = real(*args, **kw)
+        err = SolverError("gait optimisation failed after 26 iterations: iteration limit reached; every "
+                          "constraint holds at the last iterate (the optimality conditions do not)")
+        err.feasible = out
+        raise err
+
+    monkeypatch.setattr(go, "_solve_nlp", stopped)
+    with pytest.raises(SolverError, match="every constraint holds") as info:
+        optimize_gait(compass_two_modes_hzd(), nodes=20, speed=0.6, guess="interpolate", step_time=0.7)
+    g = info.value.gait
+    assert g is not None and g.modes == ["left", "right"] and g.max_violation <= 1e-9
+    assert g.speed == pytest.approx(0.6, rel=1e-9)

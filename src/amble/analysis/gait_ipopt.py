@@ -59,6 +59,10 @@ def _solve_nlp(ca: Any, nlp: dict[str, Any], opts: dict[str, Any], progress: boo
         binding = (f"most violated: {worst[0]} (by {worst[1]['max_violation']:.3g})"
                    if worst[1]["max_violation"] > tol else "at the starting point" if not stats.get("iter_count")
                    else "every constraint holds at the last iterate (the optimality conditions do not)")
-        raise SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
+        err = SolverError(f"gait optimisation failed after {stats.get('iter_count', '?')} iterations: {reason}; "
                           f"{binding}")
+        if stats.get("iter_count") and worst[1]["max_violation"] <= tol:
+            # a gait that satisfies every constraint, not certified optimal: the caller may keep it
+            err.feasible = (sol, stats, report, elapsed)
+        raise err
     return sol, stats, report, elapsed

@@ -39,7 +39,7 @@ import sympy as sp
 
 from ..backend.cache import fingerprint
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
-from ..errors import ParameterError
+from ..errors import ParameterError, SolverError
 from ..modelling.footfall_cycle import cycle_footfalls
 from ..modelling.hybrid import HybridSystem
 from .collocation import defects, simpson_weights
@@ -283,12 +283,13 @@ def optimize_gait(
             # of re-solving from a central path (RABBIT 20 → 60 intervals: 10 iterations, not 83)
             opts.update({"ipopt.mu_init": 1e-5, "ipopt.warm_start_init_point": "yes",
                          "ipopt.warm_start_bound_push": 1e-8, "ipopt.warm_start_mult_bound_push": 1e-8})
-        sol, stats, report, elapsed = _solve_nlp(ca, {"x": w, "f": J, "g": g}, opts, progress, tol, groups,
-                                                 bound_groups, feasibility=feasibility or nothing_to_optimise,
-                                                 x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
+        sol, stats, report, elapsed = _solve_keeping_feasible(
+            ca, {"x": w, "f": J, "g": g}, opts, progress, tol, groups, bound_groups,
+            feasibility=feasibility or nothing_to_optimise, x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
         wopt = np.asarray(sol["x"]).ravel()
         status = stats.get("return_status", "unknown")
         info = {"status": status, "iterations": int(stats.get("iter_count", 0)), "time_s": elapsed, "nodes": N}
+        failure = stats.get("failure")
         out, start = [], 0
         for j in range(S):
             size = ws[j].numel()
@@ -297,6 +298,7 @@ def optimize_gait(
             out.append(_gait(system, models[j], fnss[j], pvs[j], wopt[start:start + size], N, objective,
                              float(sol["f"]), report, dict(info), bezier_degree, alpha))
             start += size
+        _raise_with_gait(failure, out, [footfalls[j % len(footfalls)].source for j in range(S)])
         return out
 
     stages = solve_stages(fnss[0], x_guesses[0], Ps[0], levels, hzd)
@@ -331,6 +333,27 @@ def _run_stages(solve: Any, stages: list[tuple[int, bool, bool, bool]], x_guesse
         secs += warms[0].solver["time_s"]
     assert warms is not None
     return warms, iters, secs
+
+
+def _solve_keeping_feasible(*args: Any, **kw: Any) -> tuple[dict, dict, dict, float]:
+    """:func:`~amble.analysis.gait_ipopt._solve_nlp`; a failure whose last iterate satisfies every
+    constraint comes back as a solution with the error in ``stats["failure"]``, to be raised again
+    with its gait once read back (:func:`_raise_with_gait`)."""
+    try:
+        return _solve_nlp(*args, **kw)
+    except SolverError as e:
+        if getattr(e, "feasible", None) is None:
+            raise
+        sol, stats, report, elapsed = e.feasible
+        return sol, {**stats, "failure": e}, report, elapsed
+
+
+def _raise_with_gait(failure: SolverError | None, gaits: list[Gait], modes: list[str]) -> None:
+    """Raise ``failure`` (if any) carrying the gait of its last iterate: feasible, not optimal."""
+    if failure is None:
+        return
+    failure.gait = gaits[0] if len(gaits) == 1 else period_gait(gaits, modes)
+    raise failure
 
 
 def _is_zero(objective: Any, model: Any) -> bool:
