@@ -190,7 +190,8 @@ def _run_parameters(system: Any, ranges: list[tuple[str, float, float, int]], ar
     else:
         summary["stable"] = sum(1 for r in res.rows if r["stable"] == "true")
         # the map's bifurcation curves: sign changes between neighbouring cells of one branch
-        found = map_crossings(res, system, params=common["params"], **{k: common[k] for k in ("tol",) if k in common})
+        found = (map_crossings(res, system, params=common["params"], **{k: common[k] for k in ("tol",) if k in common})
+                 if res.kind == "fixed-point-map" else [])
         summary["crossings"] = [c._asdict() for c in found]
     summary.update(res.counts())
     return _point_summary(res, names, summary)
