@@ -118,10 +118,10 @@ def test_a_solver_stopped_at_a_feasible_point_hands_back_its_gait(monkeypatch):
     """IPOPT stopped where every constraint holds but optimality is not certified (the iteration
     limit on a 3D biped): the error carries the periodic gait of its last iterate, read back like
     a solution. The stop is made here by letting the solver finish and reporting it as stopped."""
-    import amble.analysis.gait_optimisation as go
+    import amble.analysis.gait_ipopt as gi
     from amble.errors import SolverError
 
-    real = go._solve_nlp
+    real = gi._solve_nlp
 
     def stopped(*args, **kw):
         out = real(*args, **kw)
@@ -130,7 +130,7 @@ def test_a_solver_stopped_at_a_feasible_point_hands_back_its_gait(monkeypatch):
         err.feasible = out
         raise err
 
-    monkeypatch.setattr(go, "_solve_nlp", stopped)
+    monkeypatch.setattr(gi, "_solve_nlp", stopped)
     with pytest.raises(SolverError, match="every constraint holds") as info:
         optimize_gait(compass_two_modes_hzd(), nodes=20, speed=0.6, guess="interpolate", step_time=0.7)
     g = info.value.gait

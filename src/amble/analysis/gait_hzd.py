@@ -60,3 +60,12 @@ def bezier_start(fns: StepFunctions, x: np.ndarray, P: np.ndarray, degree: int) 
     Y = np.array([np.asarray(fns.outputs(xi[: fns.n], P), float).ravel() for xi in x])
     alpha, *_ = np.linalg.lstsq(bernstein(s, degree), Y, rcond=None)
     return alpha.T
+
+
+def controller_key(fns: StepFunctions) -> tuple | None:
+    """The parameter names of a step's own virtual constraints (its Bézier coefficients and phase
+    range), or None without them."""
+    vc = fns.virtual
+    if vc is None:
+        return None
+    return (*(k for row in vc["alpha"] for k in row), vc["phase_start"], vc["phase_end"])

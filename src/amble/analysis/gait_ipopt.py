@@ -10,7 +10,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import SolverError
-from .gait_result import constraint_report
+from .gait_result import Gait, constraint_report
+from .gait_stages import period_gait
 from .solver_io import Interrupts, StdoutToStderr
 
 _FAILURES = {
@@ -66,3 +67,24 @@ def _solve_nlp(ca: Any, nlp: dict[str, Any], opts: dict[str, Any], progress: boo
             err.feasible = (sol, stats, report, elapsed)
         raise err
     return sol, stats, report, elapsed
+
+
+def solve_keeping_feasible(*args: Any, **kw: Any) -> tuple[dict, dict, dict, float]:
+    """:func:`_solve_nlp`; a failure whose last iterate satisfies every
+    constraint comes back as a solution with the error in ``stats["failure"]``, to be raised again
+    with its gait once read back (:func:`raise_with_gait`)."""
+    try:
+        return _solve_nlp(*args, **kw)
+    except SolverError as e:
+        if getattr(e, "feasible", None) is None:
+            raise
+        sol, stats, report, elapsed = e.feasible
+        return sol, {**stats, "failure": e}, report, elapsed
+
+
+def raise_with_gait(failure: SolverError | None, gaits: list[Gait], modes: list[str]) -> None:
+    """Raise ``failure`` (if any) carrying the gait of its last iterate: feasible, not optimal."""
+    if failure is None:
+        return
+    failure.gait = gaits[0] if len(gaits) == 1 else period_gait(gaits, modes)
+    raise failure

@@ -39,16 +39,16 @@ import sympy as sp
 
 from ..backend.cache import fingerprint
 from ..backend.casadi_export import StepFunctions, casadi_module, step_functions
-from ..errors import ParameterError, SolverError
+from ..errors import ParameterError
 from ..modelling.footfall_cycle import cycle_footfalls
 from ..modelling.hybrid import HybridSystem
 from .collocation import defects, simpson_weights
-from .gait_hzd import bezier_start, virtual_constraints
-from .gait_ipopt import _solve_nlp
+from .gait_hzd import bezier_start, controller_key, virtual_constraints
+from .gait_ipopt import raise_with_gait, solve_keeping_feasible
 from .gait_layout import _bound_groups, _bounds, _gait
 from .gait_options import _check_options, _check_stability_option, _expression, _integrand, _parameters
 from .gait_result import Gait
-from .gait_stability import momentum_function, period_multiplier
+from .gait_stability import momenta, period_rows, stability_report
 from .gait_stages import period_gait, solve_stages
 from .gait_start import initial_guess, start_vector
 
@@ -137,9 +137,7 @@ def optimize_gait(
     if step_params is not None and len(step_params) != S:
         raise ParameterError(f"step_params must hold one mapping per step ({S}), got {len(step_params)}")
     pvs = [_parameters(system, {**pvals, **dict(sp_ or {})}) for sp_ in (step_params or [{}] * S)]
-    models, fnss = _period_functions(system, footfalls, S, objective, phase)
-    # no inputs, or a zero integrand: any gait that satisfies the constraints is optimal
-    nothing_to_optimise = fnss[0].nu == 0 or (fnss[0].integrand is not None and _is_zero(objective, models[0]))
+    models, fnss, nothing_to_optimise = _period_functions(system, footfalls, S, objective, phase)
     fns = fnss[0]
     n, nu, d = fns.n, fns.nu, fns.dims
     Ps = [np.array([pv[k] for k in f.param_names]) for f, pv in zip(fnss, pvs)]
@@ -147,7 +145,7 @@ def optimize_gait(
     levels = [nodes] if isinstance(nodes, int) else list(nodes)
     guesses = initial_guess(system, fnss, pvals, guess, levels[0], step_time, posture, steps=S)
     x_guesses, t_guesses = [x for x, _ in guesses], [t for _, t in guesses]
-    sigmas = _momenta(fnss, x_guesses, Ps, max_multiplier, hzd)
+    sigmas = momenta(fnss, x_guesses, Ps, max_multiplier, hzd)
 
     def solve(N: int, x_guesses: list[np.ndarray], t_guesses: list[float], warms: list[Gait] | None, hzd: bool,
               feasibility: bool = False, refine: bool = True) -> list[Gait]:
@@ -180,7 +178,7 @@ def optimize_gait(
             X, A, U = ca.MX.sym(f"x{j}", 2 * n, K), ca.MX.sym(f"a{j}", n, K), ca.MX.sym(f"u{j}", nu, K)
             Tv, QE, LAM = ca.MX.sym(f"T{j}"), ca.MX.sym(f"qe{j}", n + d), ca.MX.sym(f"lam{j}", d)
             PW = ca.MX.sym(f"power{j}", 2 * nu if cot else 0, K)  # positive and negative parts of each power
-            key = _controller_key(fns) if hzd else None
+            key = controller_key(fns) if hzd else None
             owner = owners.get(key) if key is not None else None
             AL = ca.MX.sym(f"alpha{j}", nu if hzd else 0, Mb + 1) if owner is None else owner[1]
             ALw = AL if owner is None else ca.MX(0, 1)  # in this step's unknowns, or in the owner's
@@ -255,7 +253,7 @@ def optimize_gait(
         for j in range(S):  # each footfall leads into the next step (the last into the first)
             qN = Xs[j][:n, -1]
             add("periodicity", fnss[j].relabel(qN, QEs[j], Ps[j]) - Xs[(j + 1) % S][:, 0])
-        _period_rows(add, Xs, Ls, Ts, sigmas if hzd else None, Ps, n, speed, max_multiplier)
+        period_rows(add, Xs, Ls, Ts, sigmas if hzd else None, Ps, n, speed, max_multiplier)
         J = sum(integrals[1:], integrals[0]) / sum(dists[1:], dists[0])
         if feasibility:
             # a first solve from a start without motion looks for any step (no objective): see gait_stages.solve_stages
@@ -283,7 +281,7 @@ def optimize_gait(
             # of re-solving from a central path (RABBIT 20 → 60 intervals: 10 iterations, not 83)
             opts.update({"ipopt.mu_init": 1e-5, "ipopt.warm_start_init_point": "yes",
                          "ipopt.warm_start_bound_push": 1e-8, "ipopt.warm_start_mult_bound_push": 1e-8})
-        sol, stats, report, elapsed = _solve_keeping_feasible(
+        sol, stats, report, elapsed = solve_keeping_feasible(
             ca, {"x": w, "f": J, "g": g}, opts, progress, tol, groups, bound_groups,
             feasibility=feasibility or nothing_to_optimise, x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
         wopt = np.asarray(sol["x"]).ravel()
@@ -298,24 +296,15 @@ def optimize_gait(
             out.append(_gait(system, models[j], fnss[j], pvs[j], wopt[start:start + size], N, objective,
                              float(sol["f"]), report, dict(info), bezier_degree, alpha))
             start += size
-        _raise_with_gait(failure, out, [footfalls[j % len(footfalls)].source for j in range(S)])
+        raise_with_gait(failure, out, [footfalls[j % len(footfalls)].source for j in range(S)])
         return out
 
     stages = solve_stages(fnss[0], x_guesses[0], Ps[0], levels, hzd)
     warms, total_iter, total_time = _run_stages(solve, stages, x_guesses, t_guesses)
     warm = warms[0] if S == 1 else period_gait(warms, [footfalls[j % len(footfalls)].source for j in range(S)])
     warm.solver.update({"iterations_total": total_iter, "time_total_s": total_time, "levels": levels})
-    warm.stability = _stability_report(sigmas, warms, Ps, n, max_multiplier)
+    warm.stability = stability_report(sigmas, warms, Ps, n, max_multiplier)
     return warm
-
-
-def _controller_key(fns: StepFunctions) -> tuple | None:
-    """The parameter names of a step's own virtual constraints (its Bézier coefficients and phase
-    range), or None without them."""
-    vc = fns.virtual
-    if vc is None:
-        return None
-    return (*(k for row in vc["alpha"] for k in row), vc["phase_start"], vc["phase_end"])
 
 
 def _run_stages(solve: Any, stages: list[tuple[int, bool, bool, bool]], x_guesses: list[np.ndarray],
@@ -335,49 +324,22 @@ def _run_stages(solve: Any, stages: list[tuple[int, bool, bool, bool]], x_guesse
     return warms, iters, secs
 
 
-def _solve_keeping_feasible(*args: Any, **kw: Any) -> tuple[dict, dict, dict, float]:
-    """:func:`~amble.analysis.gait_ipopt._solve_nlp`; a failure whose last iterate satisfies every
-    constraint comes back as a solution with the error in ``stats["failure"]``, to be raised again
-    with its gait once read back (:func:`_raise_with_gait`)."""
-    try:
-        return _solve_nlp(*args, **kw)
-    except SolverError as e:
-        if getattr(e, "feasible", None) is None:
-            raise
-        sol, stats, report, elapsed = e.feasible
-        return sol, {**stats, "failure": e}, report, elapsed
-
-
-def _raise_with_gait(failure: SolverError | None, gaits: list[Gait], modes: list[str]) -> None:
-    """Raise ``failure`` (if any) carrying the gait of its last iterate: feasible, not optimal."""
-    if failure is None:
-        return
-    failure.gait = gaits[0] if len(gaits) == 1 else period_gait(gaits, modes)
-    raise failure
-
-
-def _is_zero(objective: Any, model: Any) -> bool:
-    """Whether a user's objective is the expression 0."""
-    try:
-        return bool(_integrand(model, objective) == 0)
-    except ParameterError:
-        return False
-
-
 def _period_functions(system: HybridSystem, footfalls: list, S: int, objective: Any, phase: Any
-                      ) -> tuple[list[Any], list[StepFunctions]]:
+                      ) -> tuple[list[Any], list[StepFunctions], bool]:
     """Each step's model and exported functions over a period of ``S`` footfalls (a walker whose
-    stance feet are modes alternates its modes; one that relabels its legs repeats its one)."""
+    stance feet are modes alternates its modes; one that relabels its legs repeats its one), and
+    whether the problem has nothing to optimise (no inputs, or the integrand 0: any gait that
+    satisfies the constraints is optimal)."""
     models = [system.modes[footfalls[j % len(footfalls)].source] for j in range(S)]
-    fnss = [_step_functions(system, None if isinstance(objective, str) and objective in OBJECTIVES
-                            else _integrand(m, objective),
-                            _expression(m, phase, "phase") if phase is not None else None,
+    named = isinstance(objective, str) and objective in OBJECTIVES
+    integrands = [None if named else _integrand(m, objective) for m in models]
+    fnss = [_step_functions(system, integrands[j], _expression(m, phase, "phase") if phase is not None else None,
                             footfalls[j % len(footfalls)].name)
             for j, m in enumerate(models)]
     if any((f.n, f.nu, f.dims) != (fnss[0].n, fnss[0].nu, fnss[0].dims) for f in fnss):
         raise ParameterError(f"system {system.name!r}: the modes of a period need the same numbers of coordinates "
                              "and inputs")
-    return models, fnss
+    return models, fnss, fnss[0].nu == 0 or (integrands[0] is not None and integrands[0] == 0)
 
 
 def _period_length(system: HybridSystem, footfalls: list, steps: int | None) -> int:
@@ -392,41 +354,6 @@ def _period_length(system: HybridSystem, footfalls: list, steps: int | None) -> 
         raise ParameterError(f"steps={steps}: a gait of {system.name!r} returns to its first mode after a multiple "
                              f"of {len(footfalls)} footfalls ({cycle})")
     return steps
-
-
-def _period_rows(add: Any, Xs: list[Any], Ls: list[Any], Ts: list[Any], sigmas: list[Any] | None,
-                 Ps: list[np.ndarray], n: int, speed: float | None, max_multiplier: float | None) -> None:
-    """The constraints on a whole period: its pace, and the bound on the restricted Poincaré
-    map's multiplier over it (on a solve with the virtual constraints, ``sigmas`` given)."""
-    if max_multiplier is not None and sigmas is not None:
-        add("stability", period_multiplier(sigmas, [X[:, 0] for X in Xs], [X[:, -1] for X in Xs], Ps, n),
-            -np.inf, max_multiplier)
-    if speed is not None:
-        add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
-
-
-def _stability_report(sigmas: list[Any] | None, gaits: list[Gait], Ps: list[np.ndarray], n: int,
-                      max_multiplier: float | None) -> dict[str, Any] | None:
-    if sigmas is None:
-        return None
-    value = float(period_multiplier(sigmas, [g.fixed_point for g in gaits], [g.pre_impact_state for g in gaits],
-                                    Ps, n))
-    return {"restricted_multiplier": value, "max_multiplier": max_multiplier}
-
-
-def _momenta(fnss: list[StepFunctions], x_guesses: list[np.ndarray], Ps: list[np.ndarray],
-             max_multiplier: float | None, wanted: bool) -> list[Any] | None:
-    """The zero dynamics' momentum σ of each step of an HZD gait (``wanted``;
-    :func:`~amble.analysis.gait_stability.momentum_function`), or None where it does not exist and
-    no bound asks for it."""
-    if not wanted:
-        return None
-    try:
-        return [momentum_function(f, x, P) for f, x, P in zip(fnss, x_guesses, Ps)]
-    except ParameterError:
-        if max_multiplier is not None:
-            raise
-        return None
 
 
 #: the exported step functions per system (id, weak reference, its fingerprint and the objective's

@@ -37,6 +37,7 @@ import numpy as np
 from ..backend.casadi_export import StepFunctions, casadi_module
 from ..errors import ConvergenceError, ParameterError, StateError
 from ..modelling.hybrid import HybridSystem
+from .gait_result import Gait
 from .poincare import find_fixed_point
 
 
@@ -97,6 +98,41 @@ def restricted_multiplier(sigma: Any, x_post: Any, x_pre: Any, P: Any, n: int) -
     """``δ_zero² = (σ(x⁺)/σ(x⁻))²`` of a step from ``x_post`` to ``x_pre`` (CasADi expressions;
     with NumPy states a CasADi ``DM``)."""
     return (sigma(x_post[:n], x_post[n:], P) / sigma(x_pre[:n], x_pre[n:], P)) ** 2
+
+
+def period_rows(add: Any, Xs: list[Any], Ls: list[Any], Ts: list[Any], sigmas: list[Any] | None,
+                 Ps: list[np.ndarray], n: int, speed: float | None, max_multiplier: float | None) -> None:
+    """The constraints on a whole period: its pace, and the bound on the restricted Poincaré
+    map's multiplier over it (on a solve with the virtual constraints, ``sigmas`` given)."""
+    if max_multiplier is not None and sigmas is not None:
+        add("stability", period_multiplier(sigmas, [X[:, 0] for X in Xs], [X[:, -1] for X in Xs], Ps, n),
+            -np.inf, max_multiplier)
+    if speed is not None:
+        add("speed", sum(Ls[1:], Ls[0]) - speed * sum(Ts[1:], Ts[0]))
+
+
+def stability_report(sigmas: list[Any] | None, gaits: list[Gait], Ps: list[np.ndarray], n: int,
+                      max_multiplier: float | None) -> dict[str, Any] | None:
+    if sigmas is None:
+        return None
+    value = float(period_multiplier(sigmas, [g.fixed_point for g in gaits], [g.pre_impact_state for g in gaits],
+                                    Ps, n))
+    return {"restricted_multiplier": value, "max_multiplier": max_multiplier}
+
+
+def momenta(fnss: list[StepFunctions], x_guesses: list[np.ndarray], Ps: list[np.ndarray],
+             max_multiplier: float | None, wanted: bool) -> list[Any] | None:
+    """The zero dynamics' momentum σ of each step of an HZD gait (``wanted``;
+    :func:`~amble.analysis.gait_stability.momentum_function`), or None where it does not exist and
+    no bound asks for it."""
+    if not wanted:
+        return None
+    try:
+        return [momentum_function(f, x, P) for f, x, P in zip(fnss, x_guesses, Ps)]
+    except ParameterError:
+        if max_multiplier is not None:
+            raise
+        return None
 
 
 def closed_loop_stability(system: HybridSystem, gait: Any, params: Mapping[str, float] | None = None) -> dict:
