@@ -24,3 +24,19 @@ def compass_built():
 
     system = load("compass-gait")
     return system, compiled(system)
+
+
+@pytest.fixture
+def saved_figures(monkeypatch):
+    """The matplotlib figures saved during a test, in order (each still written to its file)."""
+    import matplotlib.pyplot as plt
+
+    figs = []
+    orig = plt.Figure.savefig
+
+    def keep(fig, *a, **k):
+        figs.append(fig)
+        return orig(fig, *a, **k)
+
+    monkeypatch.setattr(plt.Figure, "savefig", keep)
+    return figs

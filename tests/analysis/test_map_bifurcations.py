@@ -139,28 +139,16 @@ def test_a_branch_change_is_no_bifurcation():
         map_crossings(SimpleNamespace(kind="fixed-point", params=["a"], rows=[]))
 
 
-def test_map_plot_draws_the_curves_on_cell_boundaries(tmp_path, oscillator):
-    import matplotlib.pyplot as plt
-
+def test_map_plot_draws_the_curves_on_cell_boundaries(tmp_path, oscillator, saved_figures):
     from amble.viz.sweep_plots import plot_parameter_map
 
     p = {"kappa": 1.0, "T": 1.0}
     cs = np.linspace(0.0, 0.4, 5)
     res = sweep(oscillator, "fixed-point", {"e": [1.1, 1.3], "c": cs}, params=p, **SYNC)
-    figs = []
-    orig = plt.Figure.savefig
-
-    def keep(fig, *a, **k):
-        figs.append(fig)
-        return orig(fig, *a, **k)
-
-    plt.Figure.savefig = keep
-    try:
-        plot_parameter_map(res, tmp_path / "m.png", system=oscillator, params=p)
-        plot_parameter_map(_map([_row(0, 0, [0.5, -0.8], 0.1, 0), _row(0, 1, [0.5, -1.3], 0.9, 1, "lost")]),
-                           tmp_path / "b.png")
-    finally:
-        plt.Figure.savefig = orig
+    figs = saved_figures
+    plot_parameter_map(res, tmp_path / "m.png", system=oscillator, params=p)
+    plot_parameter_map(_map([_row(0, 0, [0.5, -0.8], 0.1, 0), _row(0, 1, [0.5, -1.3], 0.9, 1, "lost")]),
+                       tmp_path / "b.png")
     ax = figs[0].axes[0]
     (tor,) = [c for c in ax.collections if c.get_gid() == "crossing_torus"]
     segs = [np.asarray(s) for s in tor.get_segments()]

@@ -123,51 +123,27 @@ def _map_result(branch):
     return SimpleNamespace(params=("slope", "mh"), rows=rows)
 
 
-def test_stability_map_marks_cells_of_another_branch(tmp_path):
-    import matplotlib.pyplot as plt
-
+def test_stability_map_marks_cells_of_another_branch(tmp_path, saved_figures):
     from amble.viz.sweep_plots import plot_parameter_map
 
-    figs = []
-    orig = plt.Figure.savefig
-
-    def keep(fig, *a, **k):
-        figs.append(fig)
-        return orig(fig, *a, **k)
-
-    plt.Figure.savefig = keep
-    try:
-        plot_parameter_map(_map_result(True), tmp_path / "m.png")
-        plot_parameter_map(_map_result(False), tmp_path / "n.png")  # no branch column: no marks, no error
-    finally:
-        plt.Figure.savefig = orig
+    figs = saved_figures
+    plot_parameter_map(_map_result(True), tmp_path / "m.png")
+    plot_parameter_map(_map_result(False), tmp_path / "n.png")  # no branch column: no marks, no error
     marked = [c for c in figs[0].axes[0].collections if c.get_gid() == "branch_change"]
     assert len(marked) == 1
     assert sorted(map(tuple, marked[0].get_offsets().tolist())) == [(7.0, 0.03), (8.0, 0.03)]
     assert not [c for c in figs[1].axes[0].collections if c.get_gid() == "branch_change"]
 
 
-def test_stability_map_compares_branch_ids_within_a_row(tmp_path):
+def test_stability_map_compares_branch_ids_within_a_row(tmp_path, saved_figures):
     # a map's rows are separate tasks, each starting its branch ids at its own first point: rows
     # with different ids are not different gaits; a change of id inside a row is
-    import matplotlib.pyplot as plt
-
     from amble.viz.sweep_plots import plot_parameter_map
 
     res = _map_result(False)
     for r in res.rows:
         r["branch"] = 4 * r["i"] + (3 if (r["i"], r["j"]) == (1, 3) else 0)
-    figs = []
-    orig = plt.Figure.savefig
-
-    def keep(fig, *a, **k):
-        figs.append(fig)
-        return orig(fig, *a, **k)
-
-    plt.Figure.savefig = keep
-    try:
-        plot_parameter_map(res, tmp_path / "m.png")
-    finally:
-        plt.Figure.savefig = orig
+    figs = saved_figures
+    plot_parameter_map(res, tmp_path / "m.png")
     marked = [c for c in figs[0].axes[0].collections if c.get_gid() == "branch_change"]
     assert len(marked) == 1 and marked[0].get_offsets().tolist() == [[8.0, 0.02]]
